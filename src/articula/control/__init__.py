@@ -1,0 +1,1 @@
+"""Discrete controllers, filters and actuator models."""

@@ -1,0 +1,32 @@
+"""One exception root for articula; each subclass also inherits the matching built-in."""
+
+from __future__ import annotations
+
+
+class ArticulaError(Exception):
+    """Root of every error articula raises on purpose."""
+
+
+class ConfigError(ArticulaError, ValueError):
+    """A configuration value is missing, unknown, of the wrong type or out of range."""
+
+    def __init__(self, field: str, problem: str) -> None:
+        self.field = field
+        self.problem = problem
+        super().__init__(f"{field}: {problem}")
+
+
+class ModelError(ArticulaError, ValueError):
+    """A physical model cannot be built from the given parameters."""
+
+
+class GeometryError(ArticulaError, ValueError):
+    """A shape or mesh cannot be used for distance queries."""
+
+
+class InfeasibleError(ArticulaError, RuntimeError):
+    """A requested operating point or plan cannot be reached within the limits."""
+
+
+class DeviceError(ArticulaError, OSError):
+    """A bench rig or serial device failed or answered out of protocol."""

@@ -1,0 +1,54 @@
+"""The static and dynamic analysis of Sect. 4.2 for one motor, as one JSON-ready mapping."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from articula.errors import ConfigError
+from articula.experiments.registry import load_toml
+from articula.plants.dc_motor import (
+    PRESETS,
+    MotorParams,
+    critical_speed,
+    poles,
+    state_space,
+    steady_state,
+    transfer_matrix,
+)
+from articula.validation import parse_model
+
+
+def load_params(preset: str | None, params_file: Path | None) -> MotorParams:
+    """Motor constants from a preset name or a TOML file with keys R, K, b, J, L."""
+    if (preset is None) == (params_file is None):
+        raise ConfigError("--preset/--params", "give exactly one of --preset or --params")
+    if params_file is not None:
+        return parse_model(MotorParams, load_toml(params_file), where=str(params_file))
+    if preset not in PRESETS:
+        raise ConfigError("--preset", f"unknown preset {preset!r}; choose {', '.join(PRESETS)}")
+    return PRESETS[preset]
+
+
+def analyze(p: MotorParams, voltage: float, torque: float, current: float) -> dict[str, Any]:
+    """A, B, poles, G(s), steady state at (V, τ_ex) and ω_c at (V, i) for motor `p`."""
+    for name, value in (("--voltage", voltage), ("--torque", torque), ("--current", current)):
+        if value != value or value in (float("inf"), float("-inf")):
+            raise ConfigError(name, f"must be a finite number (got {value})")
+    A, B = state_space(p)
+    omega, i = steady_state(p, voltage, torque)
+    eig = poles(p)
+    return {
+        "params": p.model_dump(),
+        "A": A.tolist(),
+        "B": B.tolist(),
+        "poles": [_complex(z) for z in eig],
+        "transfer": {k: {"num": n, "den": d} for k, (n, d) in transfer_matrix(p).items()},
+        "steady_state": {"omega": omega, "i": i, "voltage": voltage, "torque": torque},
+        "omega_c": critical_speed(p, voltage, current),
+    }
+
+
+def _complex(z: complex) -> float | dict[str, float]:
+    """A pole as a float when real, else {"re", "im"}."""
+    return float(z.real) if abs(z.imag) < 1e-12 else {"re": float(z.real), "im": float(z.imag)}

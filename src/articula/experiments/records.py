@@ -1,0 +1,107 @@
+"""Run folders: config.toml, record.json, trace.parquet, each written atomically."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import platform
+import tempfile
+from collections.abc import Mapping
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+import tomli_w
+
+from articula.experiments.registry import Result
+
+RECORD = "record.json"
+CONFIG = "config.toml"
+TRACE = "trace.parquet"
+_VERSIONED = ("articula", "numpy", "scipy", "numba", "control", "pyarrow", "pydantic")
+
+
+def config_hash(config: Mapping[str, Any]) -> str:
+    """Short stable hash of a config mapping; names its run folder inside a sweep."""
+    canonical = json.dumps(config, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(canonical.encode()).hexdigest()[:12]
+
+
+def package_versions() -> dict[str, str]:
+    """Versions of Python and of the packages that decide the numbers."""
+    versions = {"python": platform.python_version()}
+    for name in _VERSIONED:
+        try:
+            versions[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            versions[name] = "not installed"
+    return versions
+
+
+def build_record(
+    config: Mapping[str, Any], result: Result, wall_time: float
+) -> dict[str, Any]:
+    """The JSON-ready record of one run."""
+    return {
+        "experiment": config["experiment"],
+        "seed": config.get("seed"),
+        "config_hash": config_hash(config),
+        "metrics": {k: _json_number(v) for k, v in result.metrics.items()},
+        "versions": package_versions(),
+        "wall_time_s": wall_time,
+    }
+
+
+def write_run(
+    folder: Path, config: Mapping[str, Any], record: Mapping[str, Any], trace: Mapping[str, np.ndarray]
+) -> None:
+    """Write a complete run folder; record.json goes last and marks the run finished."""
+    folder.mkdir(parents=True, exist_ok=True)
+    _atomic_write(folder / CONFIG, tomli_w.dumps(dict(config)).encode())
+    table = pa.table({k: np.asarray(v) for k, v in trace.items()})
+    sink = pa.BufferOutputStream()
+    pq.write_table(table, sink)
+    _atomic_write(folder / TRACE, sink.getvalue().to_pybytes())
+    _atomic_write(folder / RECORD, json.dumps(record, indent=2).encode())
+
+
+def is_finished(folder: Path) -> bool:
+    """True when the run folder holds a complete record."""
+    return (folder / RECORD).is_file()
+
+
+def read_record(folder: Path) -> dict[str, Any]:
+    """The record.json of a finished run."""
+    return json.loads((folder / RECORD).read_text())
+
+
+def write_table(path: Path, table: pa.Table) -> None:
+    """Write a Parquet table atomically."""
+    sink = pa.BufferOutputStream()
+    pq.write_table(table, sink)
+    _atomic_write(path, sink.getvalue().to_pybytes())
+
+
+def _atomic_write(path: Path, data: bytes) -> None:
+    """Write to a temporary file beside `path`, flush it to disk, then rename over `path`."""
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _json_number(value: float) -> float | None:
+    """A metric as JSON allows it: non-finite values become null."""
+    value = float(value)
+    return value if math.isfinite(value) else None

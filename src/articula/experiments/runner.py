@@ -1,0 +1,196 @@
+"""Run one config or a sweep of configs, locally or on Dask, never recomputing a finished run."""
+
+from __future__ import annotations
+
+import itertools
+import time
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyarrow as pa
+
+from articula.errors import ConfigError
+from articula.experiments import records
+from articula.experiments.registry import config_to_dict, parse_config
+
+RESULTS = "results.parquet"
+
+
+@dataclass(frozen=True)
+class RunOutput:
+    """A finished run as it travels back from a worker: config, record and trace."""
+
+    config: dict[str, Any]
+    record: dict[str, Any]
+    trace: dict[str, np.ndarray]
+
+
+def execute(config: Mapping[str, Any]) -> RunOutput:
+    """Validate and run one config (a mapping with its `experiment` key)."""
+    exp, model = parse_config(config)
+    full = config_to_dict(exp, model)
+    start = time.perf_counter()
+    result = exp.run(model)
+    wall = time.perf_counter() - start
+    return RunOutput(full, records.build_record(full, result, wall), result.trace)
+
+
+def run_to_folder(config: Mapping[str, Any], out: Path) -> dict[str, Any]:
+    """Run one config and write its run folder; returns the record."""
+    output = execute(config)
+    records.write_run(out, output.config, output.record, output.trace)
+    return output.record
+
+
+# ----- sweeps ---------------------------------------------------------------------------------
+
+
+def expand_sweep(spec: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """Configs of a sweep: `base` updated by every point of `grid` and every entry of `runs`.
+
+    `grid` maps dotted keys ("controller.filter_order") to lists of values and is expanded as a
+    Cartesian product; `runs` is a list of partial configs. Every config is validated here, so
+    a bad sweep fails before anything runs.
+    """
+    unknown = set(spec) - {"base", "grid", "runs"}
+    if unknown:
+        raise ConfigError(sorted(unknown)[0], "unknown sweep key; use base, grid and runs")
+    base = dict(spec.get("base", {}))
+    grid = dict(spec.get("grid", {}))
+    runs = list(spec.get("runs", [{}]))
+    for key, values in grid.items():
+        if not isinstance(values, list) or not values:
+            raise ConfigError(f"grid.{key}", "must be a non-empty list of values")
+    configs = []
+    for point in itertools.product(*grid.values()):
+        for run in runs:
+            cfg = _deep_merge(base, run)
+            for key, value in zip(grid, point, strict=True):
+                _set_dotted(cfg, key, value)
+            exp, model = parse_config(cfg)
+            configs.append(config_to_dict(exp, model))
+    hashes = [records.config_hash(c) for c in configs]
+    if len(set(hashes)) != len(hashes):
+        raise ConfigError("grid", "two points of the sweep give the same config; remove the repeat")
+    return configs
+
+
+def run_sweep(
+    configs: Sequence[Mapping[str, Any]],
+    out: Path,
+    workers: int = 1,
+    dask: str | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> pa.Table:
+    """Run every config not yet finished under `out`, then write and return results.parquet."""
+    out.mkdir(parents=True, exist_ok=True)
+    folders = {records.config_hash(c): out / records.config_hash(c) for c in configs}
+    todo = [c for c in configs if not records.is_finished(folders[records.config_hash(c)])]
+    done = len(configs) - len(todo)
+    if progress:
+        progress(done, len(configs))
+    for output in _execute_all(todo, workers, dask):
+        records.write_run(folders[output.record["config_hash"]], output.config, output.record,
+                          output.trace)  # fmt: skip
+        done += 1
+        if progress:
+            progress(done, len(configs))
+    table = results_table(configs, out)
+    records.write_table(out / RESULTS, table)
+    return table
+
+
+def results_table(configs: Sequence[Mapping[str, Any]], out: Path) -> pa.Table:
+    """One row per run: its hash, flattened config values and metrics."""
+    rows = []
+    for cfg in configs:
+        h = records.config_hash(cfg)
+        record = records.read_record(out / h)
+        row = {"run": h, **_flatten(cfg), **record["metrics"], "wall_time_s": record["wall_time_s"]}
+        rows.append(row)
+    return pa.Table.from_pylist(rows)
+
+
+def _execute_all(
+    configs: Sequence[Mapping[str, Any]], workers: int, dask: str | None
+) -> Iterator[RunOutput]:
+    """Yield finished runs in completion order from the chosen backend."""
+    if not configs:
+        return
+    if dask is not None:
+        yield from _execute_dask(configs, dask, workers)
+    elif workers <= 1:
+        for cfg in configs:
+            yield execute(cfg)
+    else:
+        with ProcessPoolExecutor(max_workers=workers) as pool:
+            futures = [pool.submit(execute, cfg) for cfg in configs]
+            for fut in as_completed(futures):
+                yield fut.result()
+
+
+def _execute_dask(
+    configs: Sequence[Mapping[str, Any]], address: str, workers: int
+) -> Iterator[RunOutput]:
+    """Run on Dask: `local` starts a loopback LocalCluster, otherwise join the given scheduler."""
+    try:
+        from distributed import Client, LocalCluster, as_completed as dask_completed
+    except ImportError:
+        raise ConfigError("--dask", "needs the dask extra: pip install 'articula[dask]'") from None
+    cluster = None
+    if address == "local":
+        cluster = LocalCluster(
+            n_workers=max(workers, 1), threads_per_worker=1, host="127.0.0.1",
+            dashboard_address=None, processes=True,
+        )  # fmt: skip
+        client = Client(cluster)
+    elif address.startswith("tcp://"):
+        client = Client(address, timeout="10s")
+    else:
+        raise ConfigError("--dask", f"expected 'local' or tcp://HOST:PORT (got {address!r})")
+    try:
+        futures = client.map(execute, list(configs), pure=False)
+        for fut in dask_completed(futures):
+            yield fut.result()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def _deep_merge(a: Mapping[str, Any], b: Mapping[str, Any]) -> dict[str, Any]:
+    """Nested copy of `a` with `b` laid over it."""
+    merged = {k: (dict(v) if isinstance(v, Mapping) else v) for k, v in a.items()}
+    for k, v in b.items():
+        if isinstance(v, Mapping) and isinstance(merged.get(k), Mapping):
+            merged[k] = _deep_merge(merged[k], v)
+        else:
+            merged[k] = v
+    return merged
+
+
+def _set_dotted(cfg: dict[str, Any], key: str, value: Any) -> None:
+    """Set cfg["a"]["b"] for key "a.b", creating tables as needed."""
+    *parents, leaf = key.split(".")
+    node = cfg
+    for part in parents:
+        node = node.setdefault(part, {})
+        if not isinstance(node, dict):
+            raise ConfigError(f"grid.{key}", f"{part!r} is not a table in the base config")
+    node[leaf] = value
+
+
+def _flatten(cfg: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
+    """Dotted keys for nested tables; values that are not scalars are left out."""
+    flat: dict[str, Any] = {}
+    for k, v in cfg.items():
+        key = f"{prefix}{k}"
+        if isinstance(v, Mapping):
+            flat.update(_flatten(v, key + "."))
+        elif isinstance(v, (int, float, str, bool)):
+            flat[key] = v
+    return flat

@@ -1,0 +1,1 @@
+"""Simulated plants: DC motor rigs (chapter 4)."""

@@ -1,0 +1,63 @@
+"""Sensors of the chapter-4 rigs: ACS712-5A Hall current sensor on a 10-bit ADC, and an encoder."""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated
+
+from numba import njit
+from pydantic import BaseModel, ConfigDict, Field
+
+PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+
+
+class CurrentSensorParams(BaseModel):
+    """ACS712-5A read by the Arduino's ADC; `ideal` bypasses noise and quantisation."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    ideal: bool = False
+    sensitivity: PositiveFloat = 0.185  # [V/A], ACS712-5A datasheet
+    zero_voltage: PositiveFloat = 2.5  # [V] output at 0 A
+    noise_pp: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.021  # [V] peak-to-peak
+    adc_bits: Annotated[int, Field(ge=1, le=24)] = 10
+    adc_vref: PositiveFloat = 5.0  # [V]
+
+    @property
+    def noise_sigma(self) -> float:
+        """Standard deviation [V] of the output noise, taking peak-to-peak as 6σ."""
+        return self.noise_pp / 6.0
+
+
+class EncoderParams(BaseModel):
+    """Shaft encoder; speed is the count difference over a window of samples."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    ideal: bool = False
+    counts_per_rev: Annotated[int, Field(ge=1)] = 375
+    window: Annotated[int, Field(ge=1, le=100_000)] = 20  # samples
+
+
+@njit(cache=True)
+def read_current(
+    current: float,
+    noise: float,
+    sensitivity: float,
+    zero_voltage: float,
+    noise_sigma: float,
+    adc_bits: int,
+    adc_vref: float,
+) -> float:
+    """Current [A] the firmware computes from one ADC sample; `noise` is a standard normal draw."""
+    volts = zero_voltage + sensitivity * current + noise_sigma * noise
+    levels = 1 << adc_bits
+    code = min(max(math.floor(volts / adc_vref * levels), 0), levels - 1)
+    # Mid-step reconstruction: the firmware's estimate is unbiased for a dithered input.
+    return ((code + 0.5) * adc_vref / levels - zero_voltage) / sensitivity
+
+
+@njit(cache=True)
+def encoder_count(theta: float, counts_per_rev: int) -> int:
+    """Integer count of an incremental encoder at shaft angle θ [rad]."""
+    return math.floor(theta * counts_per_rev / (2.0 * math.pi))

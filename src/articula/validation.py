@@ -1,0 +1,33 @@
+"""Turn pydantic validation failures into ConfigError lines that name the field."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any, TypeVar
+
+from pydantic import BaseModel, ValidationError
+
+from articula.errors import ConfigError
+
+M = TypeVar("M", bound=BaseModel)
+
+
+def parse_model(model: type[M], data: Mapping[str, Any], where: str = "") -> M:
+    """Validate `data` into `model`, raising ConfigError naming the first bad field."""
+    try:
+        return model.model_validate(dict(data))
+    except ValidationError as exc:
+        raise config_error_from(exc, where) from None
+
+
+def config_error_from(exc: ValidationError, where: str = "") -> ConfigError:
+    """The first problem of a pydantic ValidationError as a ConfigError."""
+    first = exc.errors()[0]
+    path = ".".join(str(p) for p in first["loc"]) or "config"
+    field = f"{where}: {path}" if where else path
+    if first["type"] == "extra_forbidden":
+        return ConfigError(field, "unknown key; remove it or check its spelling")
+    if first["type"] == "missing":
+        return ConfigError(field, "required key is missing")
+    got = first.get("input")
+    return ConfigError(field, f"{first['msg']} (got {got!r})")
