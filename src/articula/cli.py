@@ -12,7 +12,6 @@ import typer
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
-
 from typer.exceptions import Abort, Exit, TyperException
 
 from articula.errors import ArticulaError
@@ -102,7 +101,9 @@ def sweep(
 
 @app.command()
 def reproduce(
-    chapter: Annotated[str, typer.Argument(help="ch4 or all (chapters 1-3 are not yet built).")] = "all",
+    chapter: Annotated[
+        str, typer.Argument(help="ch4 or all (chapters 1-3 are not yet built).")
+    ] = "all",
     out_dir: OutDir = Path("report"),
     full: Annotated[bool, typer.Option("--full", help="Full-size runs instead of quick.")] = False,
     workers: Annotated[int, typer.Option(min=1, help="Local worker processes.")] = 1,

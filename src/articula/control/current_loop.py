@@ -26,8 +26,7 @@ class LoopSettings:
     """Everything the compiled loop needs, as plain numbers: gains, sensors, PWM, sample time."""
 
     dt: float  # [s]
-    R: float  # [Ω] controller's model for the feed-forward, Eq. (4.13)
-    K: float  # [N·m/A]
+    v_bias: float  # [V] constant feed-forward of Eq. (4.13)
     kp: float  # [V/A]
     ki: float  # [V/(A·s)]
     filter_order: int
@@ -63,7 +62,7 @@ def simulate_loop(
     s = settings
     _loop(
         Ad, Bd, np.ascontiguousarray(i_ref, dtype=float), float(omega_ref), noise, out,
-        s.dt, s.R, s.K, s.kp, s.ki, s.filter_order, s.dual, s.kp_speed, s.ki_speed,
+        s.dt, s.v_bias, s.kp, s.ki, s.filter_order, s.dual, s.kp_speed, s.ki_speed,
         s.v_max, s.pwm_bits, s.sensor_ideal, s.sensitivity, s.zero_voltage, s.noise_sigma,
         s.adc_bits, s.adc_vref, s.encoder_cpr, s.encoder_window,
     )  # fmt: skip
@@ -82,7 +81,7 @@ def _actuate(voltage: float, v_max: float, bits: int) -> tuple[float, float]:
 @njit(cache=True)
 def _loop(
     Ad, Bd, i_ref, omega_ref, noise, out,
-    dt, R, K, kp, ki, filter_order, dual, kp_speed, ki_speed,
+    dt, v_bias, kp, ki, filter_order, dual, kp_speed, ki_speed,
     v_max, pwm_bits, sensor_ideal, sensitivity, zero_voltage, noise_sigma,
     adc_bits, adc_vref, encoder_cpr, encoder_window,
 ):  # fmt: skip
@@ -119,7 +118,6 @@ def _loop(
             # Eq. (4.14) with e_I = i_ss − i, the stabilising sign (docs/deviations.md).
             error = i_ref[n] - i_fb
             integral += error * dt
-            v_bias = i_ref[n] * R + K * omega_ref  # Eq. (4.13)
             v1, duty1 = _actuate(v_bias + kp * error + ki * integral, v_max, pwm_bits)
             v2 = 0.0
             if dual:

@@ -26,9 +26,13 @@ def moving_average_push(buffer: np.ndarray, n: int, sample: float) -> float:
 
 
 def moving_average(signal: np.ndarray, order: int) -> np.ndarray:
-    """Filter a whole 1-D signal with the same causal moving average the loop uses."""
+    """The loop's causal moving average applied along the last axis of a whole signal."""
     if order < 1:
         raise ConfigError("filter_order", f"must be >= 1 (got {order}); 1 means no filtering")
     x = np.asarray(signal, dtype=float)
-    buffer = np.zeros(order)
-    return np.array([moving_average_push(buffer, n, v) for n, v in enumerate(x)])
+    csum = np.cumsum(x, axis=-1)
+    n = x.shape[-1]
+    lagged = np.zeros_like(csum)
+    lagged[..., order:] = csum[..., : max(n - order, 0)]
+    count = np.minimum(np.arange(1, n + 1), order)
+    return (csum - lagged) / count

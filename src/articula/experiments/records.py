@@ -43,9 +43,7 @@ def package_versions() -> dict[str, str]:
     return versions
 
 
-def build_record(
-    config: Mapping[str, Any], result: Result, wall_time: float
-) -> dict[str, Any]:
+def build_record(config: Mapping[str, Any], result: Result, wall_time: float) -> dict[str, Any]:
     """The JSON-ready record of one run."""
     return {
         "experiment": config["experiment"],
@@ -58,7 +56,10 @@ def build_record(
 
 
 def write_run(
-    folder: Path, config: Mapping[str, Any], record: Mapping[str, Any], trace: Mapping[str, np.ndarray]
+    folder: Path,
+    config: Mapping[str, Any],
+    record: Mapping[str, Any],
+    trace: Mapping[str, np.ndarray],
 ) -> None:
     """Write a complete run folder; record.json goes last and marks the run finished."""
     folder.mkdir(parents=True, exist_ok=True)

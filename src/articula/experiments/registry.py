@@ -58,7 +58,9 @@ def parse_config(data: Mapping[str, Any]) -> tuple[Experiment, BaseModel]:
     """Validate a config mapping (with its `experiment` key) into its experiment's model."""
     body = dict(data)
     if "experiment" not in body:
-        raise ConfigError("experiment", "required key is missing (e.g. experiment = \"motor.current\")")
+        raise ConfigError(
+            "experiment", 'required key is missing (e.g. experiment = "motor.current")'
+        )
     exp = experiment(str(body.pop("experiment")))
     return exp, parse_model(exp.config, body)
 

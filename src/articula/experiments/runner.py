@@ -138,7 +138,8 @@ def _execute_dask(
 ) -> Iterator[RunOutput]:
     """Run on Dask: `local` starts a loopback LocalCluster, otherwise join the given scheduler."""
     try:
-        from distributed import Client, LocalCluster, as_completed as dask_completed
+        from distributed import Client, LocalCluster
+        from distributed import as_completed as dask_completed
     except ImportError:
         raise ConfigError("--dask", "needs the dask extra: pip install 'articula[dask]'") from None
     cluster = None

@@ -1,0 +1,1 @@
+"""Matplotlib figures per chapter; imported only where plots are made."""
