@@ -8,21 +8,25 @@ from numba import njit
 from articula.errors import ConfigError
 
 
-@njit(cache=True)
-def moving_average_push(buffer: np.ndarray, n: int, sample: float) -> float:
-    """Store sample number n in the ring buffer and return the mean of the last k samples.
+@njit(cache=True, error_model="numpy")
+def moving_average_push(buffer: np.ndarray, n: int, samples: np.ndarray, means: np.ndarray) -> None:
+    """Store sample number n of each column and write the mean of its last k samples.
 
-    Eq. (4.17) prints a sum over k + 1 samples; we average the last k = len(buffer) samples so
-    the filter has unit DC gain (docs/deviations.md). Before k samples exist the mean is over
-    the samples seen so far.
+    `buffer` is (k, batch) and `samples`, `means` are (batch,). Eq. (4.17) prints a sum over
+    k + 1 samples; we average the last k samples so that the filter has unit DC gain
+    (docs/deviations.md). Before k samples exist the mean is over the samples seen so far.
     """
-    k = buffer.shape[0]
-    buffer[n % k] = sample
+    k, batch = buffer.shape
+    slot = n % k
+    for b in range(batch):
+        buffer[slot, b] = samples[b]
+        means[b] = 0.0
     count = min(n + 1, k)
-    total = 0.0
     for j in range(count):
-        total += buffer[j]
-    return total / count
+        for b in range(batch):
+            means[b] += buffer[j, b]
+    for b in range(batch):
+        means[b] /= count
 
 
 def moving_average(signal: np.ndarray, order: int) -> np.ndarray:

@@ -7,10 +7,8 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from articula.control.current_loop import LoopSettings, simulate_loop
-from articula.control.moving_average import moving_average
+from articula.control.current_loop import LoopSettings, MetricWindow, simulate_loop
 from articula.experiments.registry import Result, register
-from articula.metrics import rise_time, sinusoid_fit
 from articula.plants.dc_motor import PRESETS, MotorParams, feedforward_voltage
 from articula.plants.motor_rig import discretize, rig_matrices
 from articula.plants.motor_sensors import CurrentSensorParams, EncoderParams
@@ -121,11 +119,24 @@ def current_reference(config: CurrentControlConfig) -> np.ndarray:
     return r.current + r.amplitude * np.sin(r.frequency * time_axis(config))
 
 
-def simulate_batch(config: CurrentControlConfig, trials: int) -> dict[str, np.ndarray]:
-    """Run `trials` noise realisations as one batch; channels are (trials, steps) arrays.
+def metric_window(config: CurrentControlConfig) -> MetricWindow:
+    """Steady-state start, rise target and fitting frequency of a config's metrics."""
+    ref = config.reference
+    sinusoid = ref.amplitude > 0 and ref.frequency > 0
+    return MetricWindow(
+        settle_index=int(np.searchsorted(time_axis(config), config.settle)),
+        rise_target=float("nan") if sinusoid else ref.current,
+        frequency=ref.frequency if sinusoid else 0.0,
+    )
+
+
+def simulate_batch(
+    config: CurrentControlConfig, trials: int, record: bool = True
+) -> tuple[dict[str, np.ndarray] | None, dict[str, np.ndarray]]:
+    """Run `trials` noise realisations as one batch: (channels or None, per-trial metrics).
 
     Trial 0 equals the single run of the same config: all draws come from one Generator
-    seeded with `config.seed`, row by row.
+    seeded with `config.seed`, row by row. Channels are (trials, steps) arrays.
     """
     rng = np.random.default_rng(config.seed)
     steps = config.steps
@@ -134,50 +145,53 @@ def simulate_batch(config: CurrentControlConfig, trials: int) -> dict[str, np.nd
     )
     Ad, Bd = discretize(*rig_matrices(config.params, config.rig == "dual"), config.dt)
     i_ref = current_reference(config)
-    channels = simulate_loop(Ad, Bd, loop_settings(config), i_ref, config.reference.speed, noise)
-    channels["i_ref"] = np.broadcast_to(i_ref, noise.shape)
-    return channels
-
-
-def batch_metrics(config: CurrentControlConfig, ch: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-    """Per-trial metrics of a batch: rise time, steady-state error, noise, sinusoid tracking."""
-    t = time_axis(config)
-    steady = t >= config.settle
-    i, i_ref, i_fb = ch["i"][:, steady], ch["i_ref"][:, steady], ch["i_fb"][:, steady]
-    i_true_filtered = moving_average(ch["i"], config.controller.filter_order)[:, steady]
-    ref = config.reference
-    full = (1 << config.pwm.bits) - 1
-    saturated = (
-        np.abs(ch["duty1"]) >= full if config.pwm.bits else np.abs(ch["v1"]) >= config.pwm.v_max
+    window = metric_window(config)
+    channels, sums = simulate_loop(
+        Ad, Bd, loop_settings(config), window, i_ref, config.reference.speed, noise, record
     )
-    m: dict[str, np.ndarray] = {
-        "steady_state_error": (i - i_ref).mean(axis=1),
-        "current_rms_error": np.sqrt(((i - i_ref) ** 2).mean(axis=1)),
-        # Noise left in the fed-back signal: the filtered measurement minus the same filter
-        # applied to the true current, so the filter's lag on a moving signal is not counted.
-        "noise_rms": np.sqrt(((i_fb - i_true_filtered) ** 2).mean(axis=1)),
-        "speed_mean": ch["omega"][:, steady].mean(axis=1),
-        "saturation_fraction": saturated.mean(axis=1),
+    if channels is not None:
+        channels["i_ref"] = np.broadcast_to(i_ref, noise.shape)
+    return channels, metrics_from_sums(config, window, sums)
+
+
+def metrics_from_sums(
+    config: CurrentControlConfig, window: MetricWindow, sums: dict[str, np.ndarray]
+) -> dict[str, np.ndarray]:
+    """Per-trial metrics from the loop's running sums over the steady-state window.
+
+    steady_state_error and current_rms_error compare the true current with its reference;
+    noise_rms is the fed-back signal minus the same filter applied to the true current, so
+    the filter's lag on a moving signal is not counted as noise; rise times are 10-90 % of
+    the step from rest, found before `settle`; amplitude_ratio and phase_lag [rad, positive
+    when lagging] come from a least-squares fit c + a·sin(ωt) + b·cos(ωt) of the current.
+    """
+    t = time_axis(config)[window.settle_index :]
+    n = t.size
+    m = {
+        "steady_state_error": sums["error"] / n,
+        "current_rms_error": np.sqrt(sums["error_sq"] / n),
+        "noise_rms": np.sqrt(sums["noise_sq"] / n),
+        "speed_mean": sums["omega"] / n,
+        "saturation_fraction": sums["saturated"] / config.steps,
+        "rise_time": sums["t90"] - sums["t10"],
+        "rise_time_feedback": sums["t90_fb"] - sums["t10_fb"],
     }
-    nan = np.full(i.shape[0], np.nan)
-    if ref.amplitude > 0 and ref.frequency > 0:
-        amplitude, phase = sinusoid_fit(t[steady], i, ref.frequency)
-        m["amplitude_ratio"] = amplitude / ref.amplitude
-        m["phase_lag"] = -phase  # [rad], positive when the current lags the reference
-        m["rise_time"] = nan
-        m["rise_time_feedback"] = nan
+    nan = np.full_like(sums["error"], np.nan)
+    if window.frequency > 0:
+        basis = np.stack([np.ones_like(t), np.sin(window.frequency * t), np.cos(window.frequency * t)])
+        gram = basis @ basis.T
+        coef = np.linalg.solve(gram, np.stack([sums["i"], sums["i_sin"], sums["i_cos"]]))
+        m["amplitude_ratio"] = np.hypot(coef[1], coef[2]) / config.reference.amplitude
+        m["phase_lag"] = -np.arctan2(coef[2], coef[1])
     else:
         m["amplitude_ratio"] = nan
         m["phase_lag"] = nan
-        m["rise_time"] = rise_time(t, ch["i"], start=0.0, target=ref.current)
-        m["rise_time_feedback"] = rise_time(t, ch["i_fb"], start=0.0, target=ref.current)
     return m
 
 
 @register("motor.current", CurrentControlConfig)
 def run_current_control(config: CurrentControlConfig) -> Result:
     """Simulate one run and return its metrics and trace."""
-    ch = simulate_batch(config, trials=1)
-    metrics = {k: float(v[0]) for k, v in batch_metrics(config, ch).items()}
-    trace = {"t": time_axis(config), **{k: v[0] for k, v in ch.items()}}
-    return Result(metrics=metrics, trace=trace)
+    channels, metrics = simulate_batch(config, trials=1)
+    trace = {"t": time_axis(config), **{k: v[0] for k, v in (channels or {}).items()}}
+    return Result(metrics={k: float(v[0]) for k, v in metrics.items()}, trace=trace)

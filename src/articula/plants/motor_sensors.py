@@ -39,7 +39,7 @@ class EncoderParams(BaseModel):
     window: Annotated[int, Field(ge=1, le=100_000)] = 20  # samples
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def read_current(
     current: float,
     noise: float,
@@ -57,7 +57,7 @@ def read_current(
     return ((code + 0.5) * adc_vref / levels - zero_voltage) / sensitivity
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def encoder_count(theta: float, counts_per_rev: int) -> int:
     """Integer count of an incremental encoder at shaft angle θ [rad]."""
     return math.floor(theta * counts_per_rev / (2.0 * math.pi))

@@ -1,0 +1,119 @@
+"""Moving-average filter of Eq. (4.17), taken as a mean of the last k samples."""
+
+from __future__ import annotations
+
+import control
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from articula.control.current_loop_linear import moving_average_tf
+from articula.control.moving_average import moving_average, moving_average_push
+from articula.errors import ConfigError
+
+SAMPLES = st.lists(
+    st.floats(-1e3, 1e3, allow_nan=False, allow_infinity=False), min_size=1, max_size=120
+)
+ORDERS = st.integers(1, 40)
+
+
+def oracle(x: np.ndarray, k: int) -> np.ndarray:
+    """np.mean over the last k samples (over all samples so far before k exist)."""
+    return np.array([np.mean(x[max(0, n - k + 1) : n + 1]) for n in range(len(x))])
+
+
+def push_all(buffer: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Feed the columns of x (steps, batch) through the compiled ring buffer, step by step."""
+    out = np.full(x.shape, np.nan)
+    means = np.empty(x.shape[1])
+    for n in range(x.shape[0]):
+        moving_average_push(buffer, n, np.ascontiguousarray(x[n]), means)
+        out[n] = means
+    return out
+
+
+@settings(max_examples=50, deadline=None)
+@given(samples=SAMPLES, k=ORDERS, batch=st.integers(1, 5))
+def test_ring_buffer_equals_mean_of_last_k(samples: list[float], k: int, batch: int):
+    # Each column of the batch gets a different signal: shifted, scaled copies.
+    base = np.array(samples)
+    x = np.stack([base * (c + 1) - 7.0 * c for c in range(batch)], axis=1)
+    # Unwritten slots hold NaN: the filter must never read a slot it has not written.
+    buffer = np.full((k, batch), np.nan)
+    out = push_all(buffer, x)
+    for c in range(batch):
+        np.testing.assert_allclose(out[:, c], oracle(x[:, c], k), rtol=1e-12, atol=1e-9)
+
+
+@settings(max_examples=50, deadline=None)
+@given(samples=SAMPLES, k=ORDERS)
+def test_vectorised_filter_equals_mean_of_last_k(samples: list[float], k: int):
+    x = np.array(samples)
+    np.testing.assert_allclose(moving_average(x, k), oracle(x, k), rtol=1e-9, atol=1e-9)
+
+
+def test_ring_buffer_reused_for_a_second_signal():
+    # The compiled loop reuses one buffer for every trial of a batch, restarting n at 0.
+    k = 5
+    buffer = np.zeros((k, 1))
+    push_all(buffer, np.arange(1.0, 13.0)[:, None] * 100.0)
+    second = np.array([1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0])
+    out = push_all(buffer, second[:, None])[:, 0]
+    np.testing.assert_allclose(out, oracle(second, k))
+
+
+def test_vectorised_filter_works_along_last_axis():
+    rng = np.random.default_rng(1)
+    x = rng.normal(size=(3, 4, 50))
+    out = moving_average(x, 7)
+    assert out.shape == x.shape
+    for idx in np.ndindex(3, 4):
+        np.testing.assert_allclose(out[idx], oracle(x[idx], 7), rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("k", [1, 2, 16, 300])
+def test_unit_dc_gain(k: int):
+    x = np.full(200, 3.7)
+    np.testing.assert_allclose(moving_average(x, k), 3.7, rtol=1e-12)
+    pushed = push_all(np.zeros((k, 2)), np.full((200, 2), 3.7))
+    np.testing.assert_allclose(pushed, 3.7, rtol=1e-12)
+    # The impulse response (once the start-up is past) sums to one.
+    impulse = np.zeros(2 * k + 10)
+    impulse[k] = 1.0
+    assert moving_average(impulse, k)[k:].sum() == pytest.approx(1.0)
+
+
+def test_order_one_is_identity():
+    x = np.random.default_rng(2).normal(size=64)
+    np.testing.assert_allclose(moving_average(x, 1), x, rtol=1e-12, atol=1e-12)
+    np.testing.assert_array_equal(push_all(np.zeros((1, 1)), x[:, None])[:, 0], x)
+
+
+@pytest.mark.parametrize("order", [0, -1, -10])
+def test_order_below_one_raises_config_error(order: int):
+    with pytest.raises(ConfigError) as err:
+        moving_average(np.ones(10), order)
+    assert err.value.field == "filter_order"
+
+
+def test_mean_of_last_k_attenuates_a_sinusoid_like_a_dirichlet_kernel():
+    # Steady-state gain of a k-sample mean at ω: |sin(kωT/2) / (k sin(ωT/2))|.
+    k, dt, w = 16, 1e-3, 150.0
+    t = np.arange(4000) * dt
+    y = moving_average(np.sin(w * t), k)[1000:]
+    expected = abs(np.sin(k * w * dt / 2) / (k * np.sin(w * dt / 2)))
+    assert (y.max() - y.min()) / 2 == pytest.approx(expected, rel=2e-3)
+
+
+@pytest.mark.parametrize("k", [1, 3, 16])
+def test_linear_model_filter_matches_the_time_domain_filter(k: int):
+    dt = 1e-3
+    steps = 60
+    u = np.random.default_rng(k).normal(size=steps)
+    resp = control.forced_response(moving_average_tf(k, dt), T=np.arange(steps) * dt, U=u)
+    # Before k samples exist the linear model sums zeros (pre-history) while the loop's
+    # filter averages what it has, so compare from sample k − 1 on.
+    np.testing.assert_allclose(
+        np.ravel(resp.outputs)[k - 1 :], moving_average(u, k)[k - 1 :], atol=1e-12
+    )
