@@ -51,6 +51,22 @@ def motor_params(draw: st.DrawFn) -> MotorParams:
     )
 
 
+@st.composite
+def well_separated_motors(draw: st.DrawFn) -> MotorParams:
+    """Motors whose electrical time constant L/R is well below the mechanical one J·R/K²."""
+    R = draw(st.floats(0.5, 50.0))
+    K = draw(st.floats(0.01, 1.0))
+    tau_e = draw(st.floats(1e-4, 1e-2))
+    tau_m = draw(st.floats(10 * tau_e, 10.0))
+    return MotorParams(
+        R=R,
+        K=K,
+        b=draw(st.one_of(st.just(0.0), st.floats(1e-5, 0.05))),
+        J=tau_m * K**2 / R,
+        L=tau_e * R,
+    )
+
+
 def _motor_ode(p: MotorParams, voltage: float, torque: float):
     """Eq. (4.5) written out by hand: J ω' = K i − b ω + τ_ex, L i' = V − R i − K ω."""
 
@@ -72,7 +88,7 @@ def _simulate_to_rest(p: MotorParams, voltage: float, torque: float) -> np.ndarr
     rhs, jac = _motor_ode(p, voltage, torque)
     slowest = 1.0 / np.min(np.abs(np.linalg.eigvals(jac).real))
     sol = solve_ivp(
-        rhs, (0.0, 60.0 * slowest), [0.0, 0.0], method="Radau", jac=jac, rtol=1e-10, atol=1e-12
+        rhs, (0.0, 40.0 * slowest), [0.0, 0.0], method="Radau", jac=jac, rtol=1e-10, atol=1e-12
     )
     assert sol.success
     return sol.y[:, -1]
@@ -107,10 +123,12 @@ def test_transfer_matrix_matches_python_control_ss2tf(p: MotorParams):
         ref = control.ss2tf(control.ss(A, B[:, [col]], np.eye(2)[[row], :], 0.0))
         ref_num, ref_den = _normalised(ref.num[0][0], ref.den[0][0], 3)
         num, den = _normalised(*G[key], 3)
-        np.testing.assert_allclose(den, ref_den, rtol=1e-7)
-        # ss2tf forms the numerator by cancellation against the denominator, so it leaves
-        # round-off sized coefficients where the true one is zero.
+        # ss2tf builds both polynomials from eigenvalues that can lie decades apart (R/L
+        # against K²/(JR)), and the numerator by cancellation against the denominator, so
+        # its round-off scales with the largest coefficient; the frequency-response test
+        # below checks the small coefficients tightly.
         scale = max(np.abs(ref_num).max(), np.abs(ref_den).max())
+        np.testing.assert_allclose(den, ref_den, rtol=1e-7, atol=1e-9 * scale)
         np.testing.assert_allclose(num, ref_num, rtol=1e-7, atol=1e-9 * scale)
 
 
@@ -120,7 +138,7 @@ def test_transfer_matrix_frequency_response_matches_state_space(p: MotorParams):
     A, B = state_space(p)
     sys = control.ss(A, B, np.eye(2), np.zeros((2, 2)))
     G = transfer_matrix(p)
-    for s in (0.3j, 1.0 + 2.0j, 50j, -0.5 + 300j, 1e4j):
+    for s in (0.0, 0.3j, 1.0 + 2.0j, 50j, -0.5 + 300j, 1e4j):
         ref = np.asarray(sys(s))
         for key, (row, col) in ENTRIES.items():
             num, den = G[key]
@@ -156,9 +174,9 @@ def test_steady_state_matches_long_simulation(p: MotorParams, voltage: float, to
     np.testing.assert_allclose([omega, i], sim, rtol=1e-6, atol=1e-9)
 
 
-@settings(max_examples=15, deadline=None)
+@settings(max_examples=20, deadline=None)
 @given(
-    p=motor_params(),
+    p=well_separated_motors(),
     voltage=st.floats(-24.0, 24.0),
     torque=st.floats(-1.0, 1.0),
 )

@@ -82,10 +82,13 @@ def sweep(
     as_json: JsonFlag = False,
 ) -> None:
     """Run every config of a sweep, skipping finished runs; writes results.parquet."""
+    from articula.experiments.records import make_folder
     from articula.experiments.registry import load_toml
-    from articula.experiments.runner import RESULTS, expand_sweep, run_sweep
+    from articula.experiments.runner import RESULTS, check_backend, expand_sweep, run_sweep
 
     configs = expand_sweep(load_toml(spec))
+    check_backend(dask)
+    make_folder(out_dir)
     with _progress(as_json) as bar:
         task = bar.add_task("sweep", total=len(configs))
         table = run_sweep(
@@ -110,8 +113,12 @@ def reproduce(
     as_json: JsonFlag = False,
 ) -> None:
     """Reproduce the book's figures and tables into OUT/report.md and PNG figures."""
+    from articula.experiments.records import make_folder
+    from articula.experiments.reproduce import check_chapter
     from articula.experiments.reproduce import reproduce as run_reproduce
 
+    check_chapter(chapter)
+    make_folder(out_dir)
     with _progress(as_json) as bar:
         task = bar.add_task("reproduce", total=None)
 
@@ -161,7 +168,8 @@ def main(argv: list[str] | None = None) -> None:
     except Abort:
         _fail("aborted")
     except TyperException as exc:
-        _fail(exc.format_message().replace("\n", " "))
+        message = exc.format_message().replace("\n", " ").strip()
+        _fail(message or "missing command; see --help")
 
 
 def _fail(message: str) -> None:

@@ -20,7 +20,7 @@ MAX_STEPS = 10_000_000
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(frozen=True, extra="forbid")
+    model_config = ConfigDict(frozen=True, extra="forbid", strict=True)
 
 
 class ReferenceConfig(_Strict):
@@ -178,7 +178,9 @@ def metrics_from_sums(
     }
     nan = np.full_like(sums["error"], np.nan)
     if window.frequency > 0:
-        basis = np.stack([np.ones_like(t), np.sin(window.frequency * t), np.cos(window.frequency * t)])
+        basis = np.stack(
+            [np.ones_like(t), np.sin(window.frequency * t), np.cos(window.frequency * t)]
+        )
         gram = basis @ basis.T
         coef = np.linalg.solve(gram, np.stack([sums["i"], sums["i_sin"], sums["i_cos"]]))
         m["amplitude_ratio"] = np.hypot(coef[1], coef[2]) / config.reference.amplitude

@@ -18,11 +18,14 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import tomli_w
 
+from articula.errors import ConfigError
 from articula.experiments.registry import Result
 
 RECORD = "record.json"
 CONFIG = "config.toml"
 TRACE = "trace.parquet"
+_UMASK = os.umask(0)
+os.umask(_UMASK)
 _VERSIONED = ("articula", "numpy", "scipy", "numba", "control", "pyarrow", "pydantic")
 
 
@@ -62,13 +65,22 @@ def write_run(
     trace: Mapping[str, np.ndarray],
 ) -> None:
     """Write a complete run folder; record.json goes last and marks the run finished."""
-    folder.mkdir(parents=True, exist_ok=True)
+    make_folder(folder)
+    for stale in folder.glob(".*.tmp"):  # left by a run killed while writing
+        stale.unlink(missing_ok=True)
     _atomic_write(folder / CONFIG, tomli_w.dumps(dict(config)).encode())
     table = pa.table({k: np.asarray(v) for k, v in trace.items()})
     sink = pa.BufferOutputStream()
     pq.write_table(table, sink)
     _atomic_write(folder / TRACE, sink.getvalue().to_pybytes())
     _atomic_write(folder / RECORD, json.dumps(record, indent=2).encode())
+
+
+def make_folder(path: Path) -> None:
+    """Create an output folder, with a clear error when a file is in the way."""
+    if path.exists() and not path.is_dir():
+        raise ConfigError("--out", f"{path} is a file; give a folder path")
+    path.mkdir(parents=True, exist_ok=True)
 
 
 def is_finished(folder: Path) -> bool:
@@ -96,10 +108,17 @@ def _atomic_write(path: Path, data: bytes) -> None:
             f.write(data)
             f.flush()
             os.fsync(f.fileno())
+        os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp creates 0600; give the usual mode
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+    # Make the rename itself durable.
+    dir_fd = os.open(path.parent, os.O_RDONLY)
+    try:
+        os.fsync(dir_fd)
+    finally:
+        os.close(dir_fd)
 
 
 def _json_number(value: float) -> float | None:

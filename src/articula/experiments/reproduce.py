@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from articula.errors import ConfigError
-from articula.experiments.records import package_versions
+from articula.experiments.records import make_folder, package_versions
 
 Progress = Callable[[int, int], None]
 # A chapter section runs its experiments into OUT/<chapter>/ and returns its markdown.
@@ -22,18 +22,24 @@ def _sections() -> dict[str, tuple[str, Section]]:
     return {"ch4": ("Chapter 4: DC motor torque (current) control", ch4_section)}
 
 
+def check_chapter(chapter: str) -> None:
+    """Reject a chapter that cannot be reproduced yet."""
+    sections = _sections()
+    if chapter != "all" and chapter not in sections:
+        choices = ", ".join(["all", *sections])
+        raise ConfigError(
+            "chapter", f"{chapter!r} cannot be reproduced yet; choose one of: {choices}"
+        )
+
+
 def reproduce(
     chapter: str, out: Path, full: bool = False, workers: int = 1, progress: Progress | None = None
 ) -> dict[str, Any]:
     """Reproduce one chapter or all of them; returns a summary with the report's path."""
     sections = _sections()
-    if chapter != "all" and chapter not in sections:
-        raise ConfigError(
-            "chapter",
-            f"{chapter!r} cannot be reproduced yet; choose one of: all, {', '.join(sections)}",
-        )
+    check_chapter(chapter)
     chosen = list(sections) if chapter == "all" else [chapter]
-    out.mkdir(parents=True, exist_ok=True)
+    make_folder(out)
     start = time.perf_counter()
     notify = progress or (lambda done, total: None)
     parts = [

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import itertools
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
@@ -59,9 +60,15 @@ def expand_sweep(spec: Mapping[str, Any]) -> list[dict[str, Any]]:
     unknown = set(spec) - {"base", "grid", "runs"}
     if unknown:
         raise ConfigError(sorted(unknown)[0], "unknown sweep key; use base, grid and runs")
-    base = dict(spec.get("base", {}))
-    grid = dict(spec.get("grid", {}))
-    runs = list(spec.get("runs", [{}]))
+    base = copy.deepcopy(spec.get("base", {}))
+    grid = copy.deepcopy(spec.get("grid", {}))
+    runs = copy.deepcopy(spec.get("runs", [{}]))
+    if not isinstance(base, dict):
+        raise ConfigError("base", "must be a table of config keys ([base])")
+    if not isinstance(grid, dict):
+        raise ConfigError("grid", 'must be a table of dotted keys to lists ([grid] "a.b" = [...])')
+    if not isinstance(runs, list) or not all(isinstance(r, dict) for r in runs):
+        raise ConfigError("runs", "must be a list of tables ([[runs]])")
     for key, values in grid.items():
         if not isinstance(values, list) or not values:
             raise ConfigError(f"grid.{key}", "must be a non-empty list of values")
@@ -87,7 +94,8 @@ def run_sweep(
     progress: Callable[[int, int], None] | None = None,
 ) -> pa.Table:
     """Run every config not yet finished under `out`, then write and return results.parquet."""
-    out.mkdir(parents=True, exist_ok=True)
+    check_backend(dask)
+    records.make_folder(out)
     folders = {records.config_hash(c): out / records.config_hash(c) for c in configs}
     todo = [c for c in configs if not records.is_finished(folders[records.config_hash(c)])]
     done = len(configs) - len(todo)
@@ -102,6 +110,12 @@ def run_sweep(
     table = results_table(configs, out)
     records.write_table(out / RESULTS, table)
     return table
+
+
+def check_backend(dask: str | None) -> None:
+    """Reject a --dask value that is neither 'local' nor a tcp:// address."""
+    if dask is not None and dask != "local" and not dask.startswith("tcp://"):
+        raise ConfigError("--dask", f"expected 'local' or tcp://HOST:PORT (got {dask!r})")
 
 
 def results_table(configs: Sequence[Mapping[str, Any]], out: Path) -> pa.Table:
@@ -149,10 +163,11 @@ def _execute_dask(
             dashboard_address=None, processes=True,
         )  # fmt: skip
         client = Client(cluster)
-    elif address.startswith("tcp://"):
-        client = Client(address, timeout="10s")
     else:
-        raise ConfigError("--dask", f"expected 'local' or tcp://HOST:PORT (got {address!r})")
+        try:
+            client = Client(address, timeout="10s")
+        except (OSError, TimeoutError) as exc:
+            raise ConfigError("--dask", f"cannot reach the scheduler at {address}: {exc}") from None
     try:
         futures = client.map(execute, list(configs), pure=False)
         for fut in dask_completed(futures):

@@ -20,7 +20,7 @@ DEFAULT_INDUCTANCE = 10e-3
 class MotorParams(BaseModel):
     """Motor constants in SI: R [Ω], K = K_t = K_e [N·m/A], b [N·m·s/rad], J [kg·m²], L [H]."""
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
+    model_config = ConfigDict(frozen=True, extra="forbid", strict=True)
 
     R: Positive
     K: Positive

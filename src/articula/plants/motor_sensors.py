@@ -14,7 +14,7 @@ PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 class CurrentSensorParams(BaseModel):
     """ACS712-5A read by the Arduino's ADC; `ideal` bypasses noise and quantisation."""
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
+    model_config = ConfigDict(frozen=True, extra="forbid", strict=True)
 
     ideal: bool = False
     sensitivity: PositiveFloat = 0.185  # [V/A], ACS712-5A datasheet
@@ -32,7 +32,7 @@ class CurrentSensorParams(BaseModel):
 class EncoderParams(BaseModel):
     """Shaft encoder; speed is the count difference over a window of samples."""
 
-    model_config = ConfigDict(frozen=True, extra="forbid")
+    model_config = ConfigDict(frozen=True, extra="forbid", strict=True)
 
     ideal: bool = False
     counts_per_rev: Annotated[int, Field(ge=1)] = 375

@@ -1,0 +1,109 @@
+"""Shared fixtures: a tiny fast experiment config, TOML writing and the real console script."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import Any
+
+import pytest
+import tomli_w
+
+# The console script installed beside the interpreter running the tests (the venv's).
+_SCRIPT = Path(sys.executable).with_name("articula")
+ARTICULA = str(_SCRIPT) if _SCRIPT.exists() else shutil.which("articula")
+
+
+@pytest.fixture(scope="session")
+def articula_script() -> str:
+    """Path of the installed `articula` console script."""
+    assert ARTICULA is not None, "the articula console script is not installed"
+    return ARTICULA
+
+
+@pytest.fixture
+def tiny_config() -> dict[str, Any]:
+    """A motor.current config that simulates in milliseconds (200 steps)."""
+    return {"experiment": "motor.current", "duration": 0.2, "settle": 0.1}
+
+
+@pytest.fixture
+def write_toml(tmp_path: Path) -> Callable[..., Path]:
+    """write_toml(data, name="x.toml", where=tmp_path) -> path of the written TOML file."""
+
+    def write(
+        data: Mapping[str, Any], name: str = "config.toml", where: Path | None = None
+    ) -> Path:
+        path = (where or tmp_path) / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(tomli_w.dumps(dict(data)))
+        return path
+
+    return write
+
+
+@pytest.fixture(scope="session")
+def cli() -> Callable[..., subprocess.CompletedProcess[str]]:
+    """cli(*args, cwd=None, env=None) runs the real `articula` console script, capturing output.
+
+    `env` holds extra environment variables laid over the current environment.
+    """
+    assert ARTICULA is not None, "the articula console script is not installed"
+
+    def run(
+        *args: Any,
+        cwd: Path | None = None,
+        env: Mapping[str, str] | None = None,
+        timeout: float = 600,
+    ) -> subprocess.CompletedProcess:
+        return subprocess.run(
+            [ARTICULA, *map(str, args)],
+            capture_output=True,
+            text=True,
+            cwd=cwd,
+            env={**os.environ, **env} if env else None,
+            timeout=timeout,
+            check=False,
+        )
+
+    return run
+
+
+@pytest.fixture(scope="session")
+def assert_one_line_error() -> Callable[..., str]:
+    """Check a failed CLI call: exit status 2, exactly one non-empty stderr line, no traceback.
+
+    Returns the stderr line. `names` are substrings the line must contain (the field at fault).
+    """
+
+    def check(proc: subprocess.CompletedProcess, *names: str) -> str:
+        lines = proc.stderr.splitlines()
+        assert proc.returncode == 2, (proc.returncode, proc.stderr)
+        assert len(lines) == 1, proc.stderr
+        line = lines[0]
+        assert line.strip(), proc.stderr
+        assert "Traceback" not in proc.stderr
+        for name in names:
+            assert name in line, (name, line)
+        return line
+
+    return check
+
+
+@pytest.fixture(scope="session")
+def one_json() -> Callable[[str], dict[str, Any]]:
+    """one_json(stdout) -> the single JSON object that stdout holds, with nothing else around it."""
+
+    def parse(stdout: str) -> dict[str, Any]:
+        text = stdout.strip()
+        obj, end = json.JSONDecoder().raw_decode(text)
+        assert end == len(text), f"more than one JSON value on stdout: {stdout!r}"
+        assert isinstance(obj, dict), stdout
+        return obj
+
+    return parse
