@@ -107,9 +107,13 @@ def main() -> None:
     table = Table(title="chapter-4 current loop (1 kHz, dual rig, noisy sensor, 8-bit PWM)")
     for col in ("measure", "value", "target"):
         table.add_column(col)
-    table.add_row("realtime_factor (run_current_control, 20 s)", f"{m['realtime_factor']:.0f}", ">= 1000")
+    table.add_row(
+        "realtime_factor (run_current_control, 20 s)", f"{m['realtime_factor']:.0f}", ">= 1000"
+    )
     table.add_row("  compiled kernel only", f"{m['kernel_realtime_factor']:.0f}", "")
-    table.add_row("  baseline: same loop interpreted", f"{m['interpreted_realtime_factor']:.1f}", "")
+    table.add_row(
+        "  baseline: same loop interpreted", f"{m['interpreted_realtime_factor']:.1f}", ""
+    )
     table.add_row(f"{TRIALS} separate 1 s runs [s]", f"{m['separate_runs_s']:.3f}", "")
     table.add_row(f"one batch of {TRIALS} [s]", f"{m['batch_s']:.3f}", "")
     table.add_row("batch_speedup", f"{m['batch_speedup']:.1f}", ">= 20")

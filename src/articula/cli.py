@@ -19,6 +19,8 @@ from articula.errors import ArticulaError
 app = typer.Typer(add_completion=False, no_args_is_help=True, help=__doc__)
 motor_app = typer.Typer(no_args_is_help=True, help="Chapter 4: DC motor model and analysis.")
 app.add_typer(motor_app, name="motor")
+scene_app = typer.Typer(no_args_is_help=True, help="Chapter 1: robots, obstacles and clearances.")
+app.add_typer(scene_app, name="scene")
 err = Console(stderr=True)
 out = Console()
 
@@ -155,6 +157,37 @@ def motor_analyze(
     out.print(f"steady state at V={voltage} V, τ_ex={torque} N·m: "
               f"ω = {ss['omega']:.6g} rad/s, i = {ss['i']:.6g} A")  # fmt: skip
     out.print(f"ω_c at V={voltage} V, i={current} A: {result['omega_c']:.6g} rad/s")
+
+
+@scene_app.command("check")
+def scene_check(
+    scene_file: Annotated[
+        Path, typer.Argument(help="Scene file (TOML with [robot], [[obstacles]]).")
+    ],
+    q: Annotated[
+        str | None, typer.Option("--q", help="Joint values q1,q2,... [rad]; default q0.")
+    ] = None,
+    metric: Annotated[
+        str, typer.Option(help="gjk (signed convex distance) or vertex (book).")
+    ] = "gjk",
+    as_json: JsonFlag = False,
+) -> None:
+    """End-effector position and link-obstacle clearances of a scene at q0 or --q."""
+    from articula.scene.check import check_scene
+
+    result = check_scene(scene_file, q, metric)
+    if as_json:
+        _emit_json(result)
+        return
+    table = Table(title=f"{scene_file} ({metric} metric)")
+    table.add_column("link")
+    table.add_column("clearance [m]", justify="right")
+    for name, value in result["link_clearance"].items():
+        table.add_row(name, f"{value:.4f}")
+    out.print(table)
+    x, y, z = result["ee_position"]
+    out.print(f"end-effector at ({x:.4f}, {y:.4f}, {z:.4f}) m; minimum clearance "
+              f"{result['min_clearance']:.4f} m; collides: {result['collides']}")  # fmt: skip
 
 
 def main(argv: list[str] | None = None) -> None:

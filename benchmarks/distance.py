@@ -1,0 +1,162 @@
+"""Cost of link-obstacle distances for the iiwa14 among two mesh obstacles (issue targets).
+
+    python benchmarks/distance.py [--json]
+
+Scene: src/articula/experiments/configs/ch1/two_obstacles.toml (a bracket and a rock in front
+of the robot, Figs. 1.11-1.12 style). Configurations: random joint vectors within 60 % of the
+limits with the robot clear of both obstacles (the planner's usual situation). For each, the
+median time of one call:
+  min_distance_us    Scene.min_distance(q), no broad phase (every pair by GJK/EPA)
+  broadphase_us      Scene.min_distance(q) with the bounding-sphere broad phase (default)
+  bare_coal_us       the same work written as a bare loop: Pinocchio forward kinematics, then
+                     coal.distance on every (link, obstacle) pair from Python
+  vertex_formula_us  the book's Sect. 1.3.3 closest-vertex-pair formula (metric="vertex")
+Targets: broad phase <= 10 us; min_distance_us <= 1.3 x bare_coal_us; broadphase_us <
+bare_coal_us.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import time
+from importlib import resources
+from pathlib import Path
+
+import coal
+import numpy as np
+import pinocchio as pin
+
+from articula.experiments.registry import load_toml
+from articula.scene.config import build_scene, load_scene_spec
+
+CONFIGS = 2000
+REPEATS = 5
+
+
+def _scene_file() -> Path:
+    return Path(
+        str(resources.files("articula.experiments") / "configs" / "ch1" / "two_obstacles.toml")
+    )
+
+
+def _median_us(fn, Q: np.ndarray) -> float:
+    """Median over configurations of the best of REPEATS timings of fn(q)."""
+    times = []
+    clock = time.perf_counter_ns
+    for q in Q:
+        best = min(_time_once(fn, q, clock) for _ in range(REPEATS))
+        times.append(best)
+    return statistics.median(times) / 1e3
+
+
+def _time_once(fn, q, clock) -> int:
+    start = clock()
+    fn(q)
+    return clock() - start
+
+
+def bare_coal_loop(scene):
+    """min distance by Pinocchio FK and coal.distance on every pair, from Python."""
+    robot = scene.robot
+    model, data = robot.model, robot.data
+    links = []
+    for link in robot.links:
+        frame = model.frames[link.frame_id]
+        for shape, T in zip(link.shapes, link.placements, strict=True):
+            links.append((link.frame_id, pin.SE3(T), shape.geometry, coal.Transform3s()))
+    obstacles = []
+    for obstacle in scene.obstacles:
+        T = obstacle.pose_at(0.0)
+        for part in obstacle.parts:
+            obstacles.append((part.geometry, coal.Transform3s(T[:3, :3], T[:3, 3])))
+    request = coal.DistanceRequest()
+    request.enable_signed_distance = True
+    result = coal.DistanceResult()
+    del frame
+
+    def min_distance(q: np.ndarray) -> float:
+        pin.framesForwardKinematics(model, data, q)
+        best = np.inf
+        for frame_id, local, geometry, tf in links:
+            M = data.oMf[frame_id] * local
+            tf.setRotation(M.rotation)
+            tf.setTranslation(M.translation)
+            for obstacle_geometry, obstacle_tf in obstacles:
+                result.clear()
+                d = coal.distance(geometry, tf, obstacle_geometry, obstacle_tf, request, result)
+                best = min(best, d)
+        return best
+
+    return min_distance
+
+
+def measure() -> dict[str, float]:
+    path = _scene_file()
+    spec = load_scene_spec(load_toml(path))
+    broad, _ = build_scene(spec, path.parent, broadphase=True)
+    full, _ = build_scene(spec, path.parent, broadphase=False)
+    vertex, _ = build_scene(spec, path.parent, metric="vertex")
+    robot = broad.robot
+    rng = np.random.default_rng(0)
+    candidates = rng.uniform(0.6 * robot.lower, 0.6 * robot.upper, size=(4 * CONFIGS, robot.nq))
+    clear = candidates[full.min_distance_batch(candidates) > 0.0][:CONFIGS]
+    bare = bare_coal_loop(full)
+    agree = max(abs(bare(q) - full.min_distance(q)) for q in clear[:200])
+    return {
+        "configurations": float(len(clear)),
+        "min_distance_us": _median_us(full.min_distance, clear),
+        "broadphase_us": _median_us(broad.min_distance, clear),
+        "bare_coal_us": _median_us(bare, clear),
+        "vertex_formula_us": _median_us(vertex.min_distance, clear[:200]),
+        "bare_vs_library_max_abs_diff_m": float(agree),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--json", action="store_true", help="print one JSON object")
+    args = parser.parse_args()
+    m = measure()
+    if args.json:
+        print(json.dumps(m))
+        return
+    from rich.console import Console
+    from rich.table import Table
+
+    bare = m["bare_coal_us"]
+    table = Table(
+        title="iiwa14 vs two mesh obstacles: median per configuration over "
+        f"{int(m['configurations'])} configurations"
+    )
+    for col in ("method", "µs", "× bare coal loop", "target"):
+        table.add_column(col)
+    table.add_row("bare coal loop (baseline)", f"{bare:.2f}", "1.00", "")
+    table.add_row(
+        "min_distance, no broad phase",
+        f"{m['min_distance_us']:.2f}",
+        f"{m['min_distance_us'] / bare:.2f}",
+        "<= 1.3",
+    )
+    table.add_row(
+        "min_distance, broad phase",
+        f"{m['broadphase_us']:.2f}",
+        f"{m['broadphase_us'] / bare:.2f}",
+        "< 1, <= 10 µs",
+    )
+    table.add_row(
+        "book's vertex-pair formula",
+        f"{m['vertex_formula_us']:.2f}",
+        f"{m['vertex_formula_us'] / bare:.2f}",
+        "",
+    )
+    Console().print(table)
+    print(
+        "largest |bare - library| over 200 configurations: "
+        f"{m['bare_vs_library_max_abs_diff_m']:.2e} m"
+    )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,1 @@
+"""Convex shapes, mesh loading, poses and signed distances (GJK/EPA through coal)."""

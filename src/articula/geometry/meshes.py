@@ -1,0 +1,65 @@
+"""Mesh files (STL, OBJ, PLY, DAE) to convex parts: hull by default, decomposition on request."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import trimesh
+
+from articula.errors import GeometryError
+from articula.geometry.shapes import ConvexShape, convex_hull
+
+FORMATS = (".stl", ".obj", ".ply", ".dae")
+
+
+def load_mesh(path: Path, scale: float | tuple[float, float, float] = 1.0) -> trimesh.Trimesh:
+    """Read a mesh file into one triangle mesh [m], scaled; GeometryError for unusable files.
+
+    Scenes and multi-body files are merged into one mesh. Not being watertight is accepted:
+    distances use convex hulls, which need only the vertices.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise GeometryError(f"{path}: mesh file not found")
+    if path.suffix.lower() not in FORMATS:
+        raise GeometryError(f"{path}: unsupported mesh format; use one of {', '.join(FORMATS)}")
+    try:
+        loaded = trimesh.load(path, force="mesh", process=False)
+    except Exception as exc:  # trimesh raises many types for corrupt files
+        raise GeometryError(f"{path}: cannot read mesh ({type(exc).__name__}: {exc})") from None
+    if not isinstance(loaded, trimesh.Trimesh) or len(loaded.vertices) == 0:
+        raise GeometryError(f"{path}: the file holds no vertices")
+    vertices = np.asarray(loaded.vertices, dtype=float)
+    if not np.all(np.isfinite(vertices)):
+        raise GeometryError(f"{path}: vertices contain NaN or infinite values")
+    factor = np.broadcast_to(np.asarray(scale, dtype=float), (3,))
+    if not np.all(np.isfinite(factor)) or np.any(factor == 0):
+        raise GeometryError(f"{path}: scale must be finite and non-zero (got {scale})")
+    return trimesh.Trimesh(vertices * factor, np.asarray(loaded.faces), process=False)
+
+
+def convex_parts(
+    mesh: trimesh.Trimesh, name: str, decompose: bool = False, threshold: float = 0.05
+) -> list[ConvexShape]:
+    """Convex pieces standing for `mesh`: its hull, or a CoACD decomposition when `decompose`.
+
+    The hull is conservative (every point of the mesh is inside it). The decomposition follows
+    concavities more tightly, to within `threshold` (CoACD's concavity bound, relative).
+    """
+    if not decompose:
+        return [convex_hull(mesh.vertices, name)]
+    try:
+        import coacd
+    except ImportError:
+        raise GeometryError(f"{name}: decomposition needs the coacd package") from None
+    if not (0 < threshold <= 1):
+        raise GeometryError(f"{name}: threshold must be in (0, 1] (got {threshold})")
+    coacd.set_log_level("error")
+    # CoACD repairs non-manifold input itself ("manifold" preprocessing); its seed is fixed so
+    # that the same file always gives the same parts.
+    parts = coacd.run_coacd(
+        coacd.Mesh(np.asarray(mesh.vertices), np.asarray(mesh.faces)),
+        threshold=threshold, preprocess_mode="auto", seed=0,
+    )  # fmt: skip
+    return [convex_hull(np.asarray(v), f"{name}[{i}]") for i, (v, _) in enumerate(parts)]

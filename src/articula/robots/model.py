@@ -1,0 +1,152 @@
+"""RobotModel: forward kinematics, limits, Jacobians and link collision shapes of a serial arm."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from articula.errors import ConfigError, ModelError
+from articula.geometry.shapes import ConvexShape
+from articula.robots.urdf_geometry import collision_shapes
+
+BUILTIN = {"iiwa14": ("iiwa14/iiwa14.urdf", "iiwa_link_ee")}
+
+
+@dataclass(frozen=True, eq=False)
+class LinkGeometry:
+    """A link's collision shapes and their poses in the link frame."""
+
+    name: str
+    frame_id: int
+    shapes: tuple[ConvexShape, ...]
+    placements: tuple[np.ndarray, ...]  # pose of each shape in the link frame (4×4)
+
+
+class RobotModel:
+    """A serial arm of 1-DoF revolute or prismatic joints, loaded from a URDF."""
+
+    def __init__(self, model: pin.Model, links: Sequence[LinkGeometry], ee_frame: str) -> None:
+        if not model.existFrame(ee_frame):
+            names = [f.name for f in model.frames if f.type == pin.FrameType.BODY]
+            raise ConfigError("ee_frame", f"no frame {ee_frame!r}; the links are {names}")
+        self.model = model
+        self.data = model.createData()
+        self.links = tuple(links)
+        self.ee_frame = ee_frame
+        self.ee_frame_id = model.getFrameId(ee_frame)
+
+    @classmethod
+    def from_urdf(
+        cls, path: str | Path, package_dirs: Sequence[str | Path] = (), ee_frame: str | None = None
+    ) -> RobotModel:
+        """Load kinematics and collision shapes; `ee_frame` defaults to the last link."""
+        urdf = Path(path)
+        if not urdf.is_file():
+            raise ConfigError("urdf", f"{urdf}: file not found")
+        try:
+            model = pin.buildModelFromUrdf(str(urdf))
+        except (RuntimeError, ValueError) as exc:
+            raise ModelError(f"{urdf}: Pinocchio cannot build the model ({exc})") from None
+        _check_serial(model, urdf)
+        shapes = collision_shapes(urdf, [Path(d) for d in package_dirs])
+        links = []
+        for name, items in shapes.items():
+            if not model.existFrame(name, pin.FrameType.BODY):
+                continue
+            frame_id = model.getFrameId(name, pin.FrameType.BODY)
+            links.append(
+                LinkGeometry(name, frame_id, tuple(s for s, _ in items), tuple(T for _, T in items))
+            )
+        links.sort(key=lambda link: link.frame_id)
+        if ee_frame is None:
+            ee_frame = [f.name for f in model.frames if f.type == pin.FrameType.BODY][-1]
+        return cls(model, links, ee_frame)
+
+    @classmethod
+    def builtin(cls, name: str) -> RobotModel:
+        """A robot shipped with articula: "iiwa14" (KUKA LBR iiwa 14 R820)."""
+        if name not in BUILTIN:
+            raise ConfigError(
+                "robot.builtin", f"unknown robot {name!r}; choose one of {sorted(BUILTIN)}"
+            )
+        relative, ee_frame = BUILTIN[name]
+        with resources.as_file(resources.files("articula.robots") / "data" / relative) as urdf:
+            return cls.from_urdf(urdf, ee_frame=ee_frame)
+
+    @property
+    def nq(self) -> int:
+        """Number of joints."""
+        return self.model.nq
+
+    @property
+    def joint_names(self) -> list[str]:
+        """Names of the actuated joints, base to tip."""
+        return list(self.model.names)[1:]
+
+    @property
+    def lower(self) -> np.ndarray:
+        """Lower joint limits [rad or m]."""
+        return self.model.lowerPositionLimit.copy()
+
+    @property
+    def upper(self) -> np.ndarray:
+        """Upper joint limits [rad or m]."""
+        return self.model.upperPositionLimit.copy()
+
+    def check_q(self, q: Sequence[float] | np.ndarray, field: str = "q") -> np.ndarray:
+        """q as a float array of length nq, or ConfigError naming the problem."""
+        if type(q) is np.ndarray and q.dtype == np.float64 and q.shape == (self.nq,):
+            arr = q  # the planner's hot path: no copy
+        else:
+            arr = np.asarray(q, dtype=float)
+            if arr.shape != (self.nq,):
+                raise ConfigError(field, f"needs {self.nq} joint values (got shape {arr.shape})")
+        # One dot product catches NaN and ±inf (an overflow only sends us to the exact test).
+        if not math.isfinite(arr @ arr) and not np.all(np.isfinite(arr)):
+            raise ConfigError(field, f"joint values must be finite (got {arr.tolist()})")
+        return arr
+
+    def forward(self, q: np.ndarray) -> None:
+        """Update every frame placement for configuration q (unchecked, for hot loops)."""
+        pin.framesForwardKinematics(self.model, self.data, q)
+
+    def ee_pose(self, q: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Pose of the end-effector frame in the world (4×4)."""
+        self.forward(self.check_q(q))
+        return self.data.oMf[self.ee_frame_id].homogeneous.copy()
+
+    def ee_position(self, q: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Position [m] of the end-effector frame in the world."""
+        return self.ee_pose(q)[:3, 3]
+
+    def link_poses(self, q: Sequence[float] | np.ndarray) -> dict[str, np.ndarray]:
+        """Pose (4×4, world) of every body frame, by link name."""
+        self.forward(self.check_q(q))
+        return {
+            f.name: self.data.oMf[i].homogeneous.copy()
+            for i, f in enumerate(self.model.frames)
+            if f.type == pin.FrameType.BODY
+        }
+
+    def jacobian(self, q: Sequence[float] | np.ndarray) -> np.ndarray:
+        """6×nq Jacobian of the end-effector: rows vx, vy, vz, wx, wy, wz in world axes."""
+        arr = self.check_q(q)
+        return pin.computeFrameJacobian(
+            self.model, self.data, arr, self.ee_frame_id, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+        ).copy()
+
+
+def _check_serial(model: pin.Model, urdf: Path) -> None:
+    """Only 1-DoF joints (revolute, prismatic) are supported, one per configuration entry."""
+    for joint, name in zip(model.joints[1:], model.names[1:], strict=True):
+        if joint.nq != 1 or joint.nv != 1:
+            raise ModelError(
+                f"{urdf}: joint {name!r} ({joint.shortname()}) is not a 1-DoF revolute or "
+                "prismatic joint; continuous joints need finite limits (type revolute)"
+            )

@@ -1,0 +1,99 @@
+"""Collision geometry of a URDF: each link's <collision> elements as convex shapes."""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from articula.errors import GeometryError, ModelError
+from articula.geometry.meshes import load_mesh
+from articula.geometry.poses import pose
+from articula.geometry.shapes import ConvexShape, box, convex_hull, cylinder, sphere
+
+
+def collision_shapes(
+    urdf: Path, package_dirs: Sequence[Path] = ()
+) -> dict[str, list[tuple[ConvexShape, np.ndarray]]]:
+    """Link name -> [(shape, pose of the shape in the link frame)] for every <collision>."""
+    try:
+        root = ET.parse(urdf).getroot()
+    except (ET.ParseError, OSError) as exc:
+        raise ModelError(f"{urdf}: cannot read URDF ({exc})") from None
+    shapes: dict[str, list[tuple[ConvexShape, np.ndarray]]] = {}
+    for link in root.findall("link"):
+        name = link.get("name", "")
+        for i, element in enumerate(link.findall("collision")):
+            geometry = element.find("geometry")
+            if geometry is None or len(geometry) == 0:
+                raise ModelError(f"{urdf}: link {name!r} has a <collision> without <geometry>")
+            where = f"{urdf}: link {name!r} collision {i}"
+            shape = _shape(geometry[0], urdf, package_dirs, where)
+            shapes.setdefault(name, []).append((shape, _origin(element.find("origin"), where)))
+    return shapes
+
+
+def resolve_mesh_path(filename: str, urdf: Path, package_dirs: Sequence[Path]) -> Path:
+    """File path of a URDF mesh reference: package://, file:// or relative to the URDF."""
+    if filename.startswith("package://"):
+        package, _, rest = filename.removeprefix("package://").partition("/")
+        candidates = [Path(d) / package / rest for d in package_dirs]
+        candidates += [Path(d) / rest for d in package_dirs]
+        candidates.append(urdf.parent / rest)
+        for candidate in candidates:
+            if candidate.is_file():
+                return candidate
+        raise GeometryError(
+            f"{urdf}: cannot find {filename}; pass the folder that holds package "
+            f"{package!r} in package_dirs"
+        )
+    if filename.startswith("file://"):
+        return Path(filename.removeprefix("file://"))
+    path = Path(filename)
+    return path if path.is_absolute() else urdf.parent / path
+
+
+def _shape(
+    element: ET.Element, urdf: Path, package_dirs: Sequence[Path], where: str
+) -> ConvexShape:
+    try:
+        if element.tag == "mesh":
+            path = resolve_mesh_path(element.get("filename", ""), urdf, package_dirs)
+            scale = _floats(element.get("scale", "1 1 1"), 3, where)
+            return convex_hull(load_mesh(path, scale).vertices, str(path))
+        if element.tag == "box":
+            return box(_floats(element.get("size", ""), 3, where))
+        if element.tag == "cylinder":
+            return cylinder(
+                float(element.get("radius", "nan")), float(element.get("length", "nan"))
+            )
+        if element.tag == "sphere":
+            return sphere(float(element.get("radius", "nan")))
+    except ValueError as exc:
+        if isinstance(exc, GeometryError):
+            raise GeometryError(f"{where}: {exc}") from None
+        raise ModelError(f"{where}: {exc}") from None
+    raise ModelError(
+        f"{where}: unsupported geometry <{element.tag}>; use mesh, box, cylinder or sphere"
+    )
+
+
+def _origin(element: ET.Element | None, where: str) -> np.ndarray:
+    if element is None:
+        return np.eye(4)
+    return pose(
+        _floats(element.get("xyz", "0 0 0"), 3, where),
+        _floats(element.get("rpy", "0 0 0"), 3, where),
+    )
+
+
+def _floats(text: str, count: int, where: str) -> tuple[float, ...]:
+    try:
+        values = tuple(float(v) for v in text.split())
+    except ValueError:
+        raise ModelError(f"{where}: expected {count} numbers (got {text!r})") from None
+    if len(values) != count:
+        raise ModelError(f"{where}: expected {count} numbers (got {text!r})")
+    return values

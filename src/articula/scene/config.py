@@ -1,0 +1,140 @@
+"""Scene files: the [robot] and [[obstacles]] tables of a TOML file, validated."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from articula.errors import ConfigError
+from articula.geometry.meshes import convex_parts, load_mesh
+from articula.geometry.poses import pose
+from articula.geometry.shapes import ConvexShape, box, capsule, cylinder, sphere
+from articula.robots.model import RobotModel
+from articula.scene.obstacles import Obstacle
+from articula.scene.scene import Metric, Scene
+from articula.validation import parse_model
+
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+Vec3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
+PositiveVec3 = Annotated[list[Positive], Field(min_length=3, max_length=3)]
+PositivePair = Annotated[list[Positive], Field(min_length=2, max_length=2)]
+SHAPE_KEYS = ("mesh", "box", "sphere", "cylinder", "capsule")
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(frozen=True, extra="forbid", strict=True)
+
+
+class RobotSpec(_Strict):
+    """[robot]: a built-in robot or a URDF, and its initial configuration q0 [rad]."""
+
+    builtin: str | None = None
+    urdf: str | None = None
+    package_dirs: list[str] = []
+    ee_frame: str | None = None
+    q0: list[Finite] | None = None
+
+    @model_validator(mode="after")
+    def _one_source(self) -> RobotSpec:
+        if (self.builtin is None) == (self.urdf is None):
+            raise ValueError('give exactly one of builtin = "iiwa14" or urdf = "path"')
+        return self
+
+
+class ObstacleSpec(_Strict):
+    """[[obstacles]]: one shape (mesh file or primitive) with a pose; sizes in m."""
+
+    name: str | None = None
+    mesh: str | None = None
+    scale: Positive | PositiveVec3 = 1.0
+    decompose: bool = False  # CoACD convex decomposition instead of the hull
+    box: PositiveVec3 | None = None
+    sphere: Positive | None = None
+    cylinder: PositivePair | None = None  # [radius, length]
+    capsule: PositivePair | None = None  # [radius, length]
+    position: Vec3 = [0.0, 0.0, 0.0]
+    rpy: Vec3 = [0.0, 0.0, 0.0]
+    velocity: Vec3 | None = None  # [m/s]: the obstacle moves at constant velocity
+
+    @model_validator(mode="after")
+    def _one_shape(self) -> ObstacleSpec:
+        given = [k for k in SHAPE_KEYS if getattr(self, k) is not None]
+        if len(given) != 1:
+            raise ValueError(f"give exactly one of {', '.join(SHAPE_KEYS)} (got {given or 'none'})")
+        if self.mesh is None and (self.decompose or self.scale != 1.0):
+            raise ValueError("scale and decompose apply to mesh obstacles only")
+        return self
+
+
+class SceneSpec(_Strict):
+    """A whole scene file."""
+
+    robot: RobotSpec
+    obstacles: list[ObstacleSpec] = []
+
+
+def load_scene_spec(data: dict[str, Any], where: str = "") -> SceneSpec:
+    """Validate the [robot] and [[obstacles]] tables of a mapping (other keys are ignored)."""
+    body = {k: data[k] for k in ("robot", "obstacles") if k in data}
+    if "robot" not in body:
+        raise ConfigError(f"{where}: robot" if where else "robot", "the [robot] table is missing")
+    return parse_model(SceneSpec, body, where)
+
+
+def build_scene(
+    spec: SceneSpec, base_dir: Path, broadphase: bool = True, metric: Metric = "gjk"
+) -> tuple[Scene, np.ndarray]:
+    """The Scene and its initial configuration q0; relative paths start at `base_dir`."""
+    r = spec.robot
+    if r.builtin is not None:
+        robot = RobotModel.builtin(r.builtin)
+    else:
+        robot = RobotModel.from_urdf(
+            _path(base_dir, r.urdf or ""), [_path(base_dir, d) for d in r.package_dirs], r.ee_frame
+        )
+    q0 = robot.check_q(r.q0 if r.q0 is not None else np.zeros(robot.nq), "robot.q0")
+    obstacles = [_obstacle(o, i, base_dir) for i, o in enumerate(spec.obstacles)]
+    return Scene(robot, obstacles, broadphase=broadphase, metric=metric), q0
+
+
+def _obstacle(spec: ObstacleSpec, index: int, base_dir: Path) -> Obstacle:
+    name = spec.name or f"obstacle_{index}"
+    parts: list[ConvexShape]
+    if spec.mesh is not None:
+        mesh_path = _path(base_dir, spec.mesh)
+        scale = tuple(spec.scale) if isinstance(spec.scale, list) else spec.scale
+        parts = convex_parts(load_mesh(mesh_path, scale), name, decompose=spec.decompose)
+    else:
+        parts = [_primitive(spec)]
+    start = pose(spec.position, spec.rpy)
+    if spec.velocity is None:
+        return Obstacle(name, tuple(parts), start)
+    velocity = np.asarray(spec.velocity)
+
+    def moving(t: float) -> np.ndarray:
+        T = start.copy()
+        T[:3, 3] += velocity * t
+        return T
+
+    return Obstacle(name, tuple(parts), moving)
+
+
+def _primitive(spec: ObstacleSpec) -> ConvexShape:
+    """The one primitive an ObstacleSpec names (its validator guarantees exactly one)."""
+    if spec.box is not None:
+        return box((spec.box[0], spec.box[1], spec.box[2]))
+    if spec.sphere is not None:
+        return sphere(spec.sphere)
+    if spec.cylinder is not None:
+        return cylinder(*spec.cylinder)
+    radius, length = spec.capsule or (0.0, 0.0)
+    return capsule(radius, length)
+
+
+def _path(base_dir: Path, text: str) -> Path:
+    path = Path(text).expanduser()
+    return path if path.is_absolute() else base_dir / path

@@ -1,0 +1,51 @@
+"""Obstacles: convex parts with a pose that may change with time."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from articula.errors import GeometryError
+from articula.geometry.shapes import ConvexShape
+
+PoseOfTime = Callable[[float], np.ndarray]
+
+
+@dataclass(frozen=True, eq=False)
+class Obstacle:
+    """Named convex parts (in the obstacle frame) and the obstacle's pose in the world.
+
+    `pose` is a 4×4 matrix, or a function of time t [s] returning one (a moving obstacle).
+    """
+
+    name: str
+    parts: tuple[ConvexShape, ...]
+    pose: np.ndarray | PoseOfTime
+
+    def __post_init__(self) -> None:
+        if not self.parts:
+            raise GeometryError(f"obstacle {self.name!r}: has no convex parts")
+        if not callable(self.pose):
+            _check_pose(self.name, self.pose)
+
+    @property
+    def moving(self) -> bool:
+        """True when the pose is a function of time."""
+        return callable(self.pose)
+
+    def pose_at(self, t: float) -> np.ndarray:
+        """The obstacle's pose (4×4, world) at time t [s]."""
+        if callable(self.pose):
+            return _check_pose(self.name, np.asarray(self.pose(t), dtype=float))
+        return self.pose
+
+
+def _check_pose(name: str, T: np.ndarray) -> np.ndarray:
+    if T.shape != (4, 4) or not np.all(np.isfinite(T)):
+        raise GeometryError(f"obstacle {name!r}: pose must be a finite 4×4 matrix (got {T.shape})")
+    R = T[:3, :3]
+    if not np.allclose(R @ R.T, np.eye(3), atol=1e-6) or np.linalg.det(R) < 0:
+        raise GeometryError(f"obstacle {name!r}: pose rotation is not a rotation matrix")
+    return T

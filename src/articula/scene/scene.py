@@ -1,0 +1,270 @@
+"""Scene: a robot among obstacles, with signed link-obstacle distances (GJK/EPA via coal).
+
+Robot link shapes and obstacle parts live in one Pinocchio GeometryModel, one collision pair
+per (link shape, obstacle part), so forward kinematics, placements and every exact distance
+run in C++. A second model holds a bounding capsule per shape: capsule-capsule distances
+(closed form in coal) are lower bounds of the exact ones, which lets the broad phase skip
+pairs that cannot be the minimum.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Literal
+
+import coal
+import numpy as np
+import pinocchio as pin
+from scipy.spatial import cKDTree
+
+from articula.errors import ConfigError
+from articula.geometry.poses import transform_points
+from articula.geometry.shapes import ConvexShape
+from articula.robots.model import RobotModel
+from articula.scene.obstacles import Obstacle
+
+Metric = Literal["gjk", "vertex"]
+_NO_SUPPORT_GUESS = np.zeros(2, dtype=np.int32)
+_NO_GJK_GUESS = np.array([1.0, 0.0, 0.0])
+
+
+@dataclass(frozen=True)
+class Witnesses:
+    """Signed distances (links × obstacles) [m] and the closest points [m, world] per cell."""
+
+    distance: np.ndarray
+    on_link: np.ndarray  # (links, obstacles, 3)
+    on_obstacle: np.ndarray  # (links, obstacles, 3)
+
+
+class _Geometry:
+    """The exact and bounding-capsule geometry models with matching objects and pairs."""
+
+    def __init__(self) -> None:
+        self.exact = pin.GeometryModel()
+        self.bounds = pin.GeometryModel()
+        self.shapes: list[ConvexShape] = []
+
+    def add(self, name: str, joint: int, frame: int, placement: pin.SE3, shape: ConvexShape) -> int:
+        self.exact.addGeometryObject(
+            pin.GeometryObject(name, joint, frame, placement, shape.geometry)
+        )
+        b = shape.bound
+        bound = pin.GeometryObject(
+            name, joint, frame, placement * pin.SE3(b.pose), coal.Capsule(b.radius, b.length)
+        )
+        self.bounds.addGeometryObject(bound)
+        self.shapes.append(shape)
+        return len(self.shapes) - 1
+
+    def pair(self, a: int, b: int) -> None:
+        self.exact.addCollisionPair(pin.CollisionPair(a, b))
+        self.bounds.addCollisionPair(pin.CollisionPair(a, b))
+
+
+class Scene:
+    """A robot and its obstacles; distances for a joint configuration q at time t [s].
+
+    metric "gjk" (default): signed distance between convex shapes, negative penetration depth
+    when they overlap. metric "vertex": the book's Sect. 1.3.3 formula, the distance between
+    the closest pair of vertices, which over-states clearance (docs/deviations.md).
+    """
+
+    def __init__(
+        self,
+        robot: RobotModel,
+        obstacles: Sequence[Obstacle],
+        broadphase: bool = True,
+        metric: Metric = "gjk",
+    ) -> None:
+        if metric not in ("gjk", "vertex"):
+            raise ConfigError("metric", f"unknown metric {metric!r}; choose 'gjk' or 'vertex'")
+        names = [o.name for o in obstacles]
+        if len(set(names)) != len(names):
+            raise ConfigError("obstacles", f"obstacle names must be unique (got {names})")
+        self.robot = robot
+        self.obstacles = tuple(obstacles)
+        self.broadphase = broadphase
+        self.metric: Metric = metric
+        self.link_names = [link.name for link in robot.links]
+        geo = _Geometry()
+        link_geoms = []
+        for li, link in enumerate(robot.links):
+            frame = robot.model.frames[link.frame_id]
+            for si, (shape, T) in enumerate(zip(link.shapes, link.placements, strict=True)):
+                g = geo.add(f"{link.name}/{si}", frame.parentJoint, link.frame_id,
+                            frame.placement * pin.SE3(T), shape)  # fmt: skip
+                link_geoms.append((g, li))
+        self._obstacle_geoms = []
+        for obstacle in self.obstacles:
+            world = pin.SE3(obstacle.pose_at(0.0))
+            self._obstacle_geoms.append(
+                [
+                    geo.add(f"{obstacle.name}/{k}", 0, 0, world, p)
+                    for k, p in enumerate(obstacle.parts)
+                ]
+            )
+        cells = []
+        for g_link, li in link_geoms:
+            for oi, parts in enumerate(self._obstacle_geoms):
+                for g_obstacle in parts:
+                    geo.pair(g_link, g_obstacle)
+                    cells.append((li, oi))
+        self._geo = geo
+        self._cells = np.array(cells, dtype=np.int64).reshape(-1, 2)
+        self._exact_data = pin.GeometryData(geo.exact)
+        self._bounds_data = pin.GeometryData(geo.bounds)
+        # Element proxies made once: reading through them is several times cheaper.
+        self._results = list(self._exact_data.distanceResults)
+        self._requests = list(self._exact_data.distanceRequests)
+        self._bound_results = list(self._bounds_data.distanceResults)
+        for request in self._requests:
+            request.enable_signed_distance = True  # EPA penetration depth when overlapping
+        self._cell_of_pair = [(int(li), int(oi)) for li, oi in self._cells]
+        self._trees = [cKDTree(s.vertices) for s in geo.shapes]
+        self._moving = [oi for oi, o in enumerate(self.obstacles) if o.moving]
+        self._shape = (len(robot.links), len(self.obstacles))
+
+    # ----- queries -----------------------------------------------------------------------------
+
+    def distances(self, q: Sequence[float] | np.ndarray, t: float = 0.0) -> np.ndarray:
+        """Signed distance [m] from every link (rows) to every obstacle (columns)."""
+        return self._cell_minima(self._pair_distances(self.robot.check_q(q), t))
+
+    def witnesses(self, q: Sequence[float] | np.ndarray, t: float = 0.0) -> Witnesses:
+        """Distances with the closest point on the link and on the obstacle for each cell."""
+        d = self._pair_distances(self.robot.check_q(q), t, every_pair=True)
+        on_link = np.full((*self._shape, 3), np.nan)
+        on_obstacle = np.full((*self._shape, 3), np.nan)
+        best = np.full(self._shape, np.inf)
+        for p, (li, oi) in enumerate(self._cell_of_pair):
+            if d[p] < best[li, oi]:
+                best[li, oi] = d[p]
+                if self.metric == "gjk":
+                    on_link[li, oi] = self._results[p].getNearestPoint1()
+                    on_obstacle[li, oi] = self._results[p].getNearestPoint2()
+                else:
+                    on_link[li, oi], on_obstacle[li, oi] = self._vertex_pair(p)
+        return Witnesses(best, on_link, on_obstacle)
+
+    def min_distance(self, q: Sequence[float] | np.ndarray, t: float = 0.0) -> float:
+        """Smallest signed distance [m] between any link and any obstacle."""
+        q = self.robot.check_q(q)
+        if self.broadphase and self.metric == "gjk":
+            return self._min_broadphase(q, t)
+        return float(np.min(self._pair_distances(q, t, every_pair=True)))
+
+    def distances_batch(self, Q: np.ndarray, t: float = 0.0) -> np.ndarray:
+        """distances() for each row of Q: an array (configurations, links, obstacles)."""
+        return np.stack([self.distances(q, t) for q in self._check_batch(Q)])
+
+    def min_distance_batch(self, Q: np.ndarray, t: float = 0.0) -> np.ndarray:
+        """min_distance() for each row of Q."""
+        return np.array([self.min_distance(q, t) for q in self._check_batch(Q)])
+
+    # ----- internals ---------------------------------------------------------------------------
+
+    def _check_batch(self, Q: np.ndarray) -> np.ndarray:
+        arr = np.asarray(Q, dtype=float)
+        if arr.ndim != 2 or arr.shape[1] != self.robot.nq:
+            raise ConfigError("Q", f"needs shape (n, {self.robot.nq}) (got {arr.shape})")
+        return arr
+
+    def _move_obstacles(self, t: float) -> None:
+        """Put moving obstacles (exact shapes and bounding spheres) at their pose at time t."""
+        for oi in self._moving:
+            world = pin.SE3(self.obstacles[oi].pose_at(t))
+            for g in self._obstacle_geoms[oi]:
+                self._geo.exact.geometryObjects[g].placement = world
+                bound = pin.SE3(self._geo.shapes[g].bound.pose)
+                self._geo.bounds.geometryObjects[g].placement = world * bound
+
+    def _place(self, q: np.ndarray, t: float) -> None:
+        """Forward kinematics and every exact shape placement, obstacles at time t."""
+        self._move_obstacles(t)
+        pin.updateGeometryPlacements(self.robot.model, self.robot.data, self._geo.exact,
+                                     self._exact_data, q)  # fmt: skip
+
+    def _exact(self, p: int) -> float:
+        """Signed distance of pair p at the current placements, independent of earlier calls.
+
+        coal warm-starts GJK from the previous answer of the same pair; resetting the guess
+        makes every answer a function of the placements alone, so the broad phase and the
+        full loop give bit-identical numbers.
+        """
+        request = self._requests[p]
+        request.cached_support_func_guess = _NO_SUPPORT_GUESS
+        request.cached_gjk_guess = _NO_GJK_GUESS
+        pin.computeDistance(self._geo.exact, self._exact_data, p)
+        return self._results[p].min_distance
+
+    def _pair_distances(self, q: np.ndarray, t: float, every_pair: bool = False) -> list[float]:
+        """Distance of every pair; with the broad phase, pairs that cannot be the minimum of
+        their cell are left at +inf unless `every_pair`."""
+        n = len(self._cell_of_pair)
+        if self.metric == "vertex":
+            self._place(q, t)
+            return [self._vertex_distance(p) for p in range(n)]
+        if every_pair or not self.broadphase:
+            self._place(q, t)
+            return [self._exact(p) for p in range(n)]
+        lower = self._lower_bounds(q, t)
+        pin.updateGeometryPlacements(self.robot.model, self.robot.data, self._geo.exact,
+                                     self._exact_data)  # fmt: skip
+        out = [np.inf] * n
+        cell_best: dict[tuple[int, int], float] = {}
+        for p in sorted(range(n), key=lower.__getitem__):
+            cell = self._cell_of_pair[p]
+            if lower[p] >= cell_best.get(cell, np.inf):
+                continue
+            out[p] = self._exact(p)
+            cell_best[cell] = min(cell_best.get(cell, np.inf), out[p])
+        return out
+
+    def _lower_bounds(self, q: np.ndarray, t: float) -> list[float]:
+        """Capsule-capsule distances of every pair (lower bounds of the exact ones); also runs
+        the forward kinematics the exact placements then reuse."""
+        self._move_obstacles(t)
+        pin.computeDistances(self.robot.model, self.robot.data, self._geo.bounds,
+                             self._bounds_data, q)  # fmt: skip
+        return [r.min_distance for r in self._bound_results]
+
+    def _min_broadphase(self, q: np.ndarray, t: float) -> float:
+        lower = self._lower_bounds(q, t)
+        pin.updateGeometryPlacements(self.robot.model, self.robot.data, self._geo.exact,
+                                     self._exact_data)  # fmt: skip
+        exact = self._exact
+        best = np.inf
+        # Visit pairs by increasing lower bound; none after the first bound above the best
+        # exact distance so far can be the minimum.
+        for p in sorted(range(len(lower)), key=lower.__getitem__):
+            if lower[p] >= best:
+                break
+            d = exact(p)
+            if d < best:
+                best = d
+        return float(best)
+
+    def _cell_minima(self, pair_distances: list[float]) -> np.ndarray:
+        out = np.full(self._shape, np.inf)
+        np.minimum.at(out, (self._cells[:, 0], self._cells[:, 1]), pair_distances)
+        return out
+
+    def _vertex_pair(self, p: int) -> tuple[np.ndarray, np.ndarray]:
+        """Closest vertex pair (world) of pair p, the book's Sect. 1.3.3 formula."""
+        pair = self._geo.exact.collisionPairs[p]
+        a, b = pair.first, pair.second
+        Ta = self._exact_data.oMg[a].homogeneous
+        Tb = self._exact_data.oMg[b].homogeneous
+        # Query b's tree with a's vertices expressed in b's frame.
+        va_in_b = transform_points(np.linalg.inv(Tb) @ Ta, self._geo.shapes[a].vertices)
+        dist, idx = self._trees[b].query(va_in_b)
+        i = int(np.argmin(dist))
+        on_a = transform_points(Ta, self._geo.shapes[a].vertices[i : i + 1])[0]
+        on_b = transform_points(Tb, self._geo.shapes[b].vertices[idx[i] : idx[i] + 1])[0]
+        return on_a, on_b
+
+    def _vertex_distance(self, p: int) -> float:
+        on_a, on_b = self._vertex_pair(p)
+        return float(np.linalg.norm(on_a - on_b))
