@@ -28,8 +28,8 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from articula.experiments.registry import load_toml
 from articula.scene.config import build_scene, load_scene_spec
+from articula.validation import load_toml
 
 CONFIGS = 2000
 REPEATS = 5

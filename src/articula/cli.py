@@ -57,8 +57,8 @@ def run(
     as_json: JsonFlag = False,
 ) -> None:
     """Run one experiment config and write config.toml, record.json and trace.parquet."""
-    from articula.experiments.registry import load_toml
     from articula.experiments.runner import run_to_folder
+    from articula.validation import load_toml
 
     record = run_to_folder(load_toml(config), out_dir)
     if as_json:
@@ -85,8 +85,8 @@ def sweep(
 ) -> None:
     """Run every config of a sweep, skipping finished runs; writes results.parquet."""
     from articula.experiments.records import make_folder
-    from articula.experiments.registry import load_toml
     from articula.experiments.runner import RESULTS, check_backend, expand_sweep, run_sweep
+    from articula.validation import load_toml
 
     configs = expand_sweep(load_toml(spec))
     check_backend(dask)

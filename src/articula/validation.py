@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import tomllib
 from collections.abc import Mapping
+from pathlib import Path
 from typing import Any, TypeVar
 
 from pydantic import BaseModel, ValidationError
@@ -31,3 +33,13 @@ def config_error_from(exc: ValidationError, where: str = "") -> ConfigError:
         return ConfigError(field, "required key is missing")
     got = first.get("input")
     return ConfigError(field, f"{first['msg']} (got {got!r})")
+
+
+def load_toml(path: Path) -> dict[str, Any]:
+    """Read a TOML file into a dict, with errors that name the file."""
+    if not path.is_file():
+        raise ConfigError(str(path), "file not found; pass the path of an existing TOML file")
+    try:
+        return tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(str(path), f"not valid TOML: {exc}") from None

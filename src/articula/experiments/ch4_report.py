@@ -15,7 +15,6 @@ import numpy as np
 from articula.control.current_loop_linear import bandwidth, closed_loop, first_crossing, is_stable
 from articula.experiments import runner
 from articula.experiments.ch4 import CurrentControlConfig, loop_settings
-from articula.experiments.registry import load_toml
 from articula.plants.dc_motor import (
     TABLE_4_1,
     TABLE_4_2,
@@ -26,7 +25,7 @@ from articula.plants.dc_motor import (
     steady_state,
 )
 from articula.plants.motor_rig import discretize, rig_matrices
-from articula.validation import parse_model
+from articula.validation import load_toml, parse_model
 
 Progress = Callable[[int, int], None]
 FIGURES = {

@@ -6,7 +6,6 @@ from pathlib import Path
 from typing import Any
 
 from articula.errors import ConfigError
-from articula.experiments.registry import load_toml
 from articula.plants.dc_motor import (
     PRESETS,
     MotorParams,
@@ -16,7 +15,7 @@ from articula.plants.dc_motor import (
     steady_state,
     transfer_matrix,
 )
-from articula.validation import parse_model
+from articula.validation import load_toml, parse_model
 
 
 def load_params(preset: str | None, params_file: Path | None) -> MotorParams:

@@ -2,10 +2,8 @@
 
 from __future__ import annotations
 
-import tomllib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -63,16 +61,6 @@ def parse_config(data: Mapping[str, Any]) -> tuple[Experiment, BaseModel]:
         )
     exp = experiment(str(body.pop("experiment")))
     return exp, parse_model(exp.config, body)
-
-
-def load_toml(path: Path) -> dict[str, Any]:
-    """Read a TOML file into a dict, with errors that name the file."""
-    if not path.is_file():
-        raise ConfigError(str(path), "file not found; pass the path of an existing TOML file")
-    try:
-        return tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(str(path), f"not valid TOML: {exc}") from None
 
 
 def config_to_dict(exp: Experiment, config: BaseModel) -> dict[str, Any]:

@@ -9,6 +9,7 @@ import numpy as np
 
 from articula.errors import ConfigError
 from articula.scene.config import build_scene, load_scene_spec
+from articula.validation import load_toml
 
 
 def parse_q(text: str) -> np.ndarray:
@@ -21,10 +22,10 @@ def parse_q(text: str) -> np.ndarray:
 
 def check_scene(path: Path, q_text: str | None = None, metric: str = "gjk") -> dict[str, Any]:
     """End-effector position, clearances per link and obstacle, and whether anything collides."""
-    from articula.experiments.registry import load_toml
-
     spec = load_scene_spec(load_toml(path), str(path))
-    scene, q0 = build_scene(spec, path.parent, metric=metric)  # type: ignore[arg-type]
+    if metric not in ("gjk", "vertex"):
+        raise ConfigError("--metric", f"unknown metric {metric!r}; choose gjk or vertex")
+    scene, q0 = build_scene(spec, path.parent, metric="vertex" if metric == "vertex" else "gjk")
     q = q0 if q_text is None else scene.robot.check_q(parse_q(q_text), "--q")
     d = scene.distances(q)
     min_clearance = float(d.min()) if d.size else float("inf")
