@@ -51,22 +51,6 @@ def motor_params(draw: st.DrawFn) -> MotorParams:
     )
 
 
-@st.composite
-def well_separated_motors(draw: st.DrawFn) -> MotorParams:
-    """Motors whose electrical time constant L/R is well below the mechanical one J·R/K²."""
-    R = draw(st.floats(0.5, 50.0))
-    K = draw(st.floats(0.01, 1.0))
-    tau_e = draw(st.floats(1e-4, 1e-2))
-    tau_m = draw(st.floats(10 * tau_e, 10.0))
-    return MotorParams(
-        R=R,
-        K=K,
-        b=draw(st.one_of(st.just(0.0), st.floats(1e-5, 0.05))),
-        J=tau_m * K**2 / R,
-        L=tau_e * R,
-    )
-
-
 def _motor_ode(p: MotorParams, voltage: float, torque: float):
     """Eq. (4.5) written out by hand: J ω' = K i − b ω + τ_ex, L i' = V − R i − K ω."""
 
@@ -83,15 +67,27 @@ def _motor_ode(p: MotorParams, voltage: float, torque: float):
     return rhs, jac
 
 
+def _slowest_time_constant(jac: np.ndarray) -> float:
+    return 1.0 / np.min(np.abs(np.linalg.eigvals(jac).real))
+
+
 def _simulate_to_rest(p: MotorParams, voltage: float, torque: float) -> np.ndarray:
     """[ω, i] after a long constant-input run from rest (many slowest time constants)."""
     rhs, jac = _motor_ode(p, voltage, torque)
-    slowest = 1.0 / np.min(np.abs(np.linalg.eigvals(jac).real))
-    sol = solve_ivp(
-        rhs, (0.0, 40.0 * slowest), [0.0, 0.0], method="Radau", jac=jac, rtol=1e-10, atol=1e-12
-    )
+    t_end = 40.0 * _slowest_time_constant(jac)
+    sol = solve_ivp(rhs, (0.0, t_end), [0.0, 0.0], method="Radau", jac=jac, rtol=1e-9, atol=1e-11)
     assert sol.success
     return sol.y[:, -1]
+
+
+def _forced_response_to_rest(p: MotorParams, voltage: float, torque: float) -> np.ndarray:
+    """[ω, i] at the end of a long python-control simulation of Eq. (4.5) from rest."""
+    _, jac = _motor_ode(p, voltage, torque)
+    B = np.array([[1.0 / p.J, 0.0], [0.0, 1.0 / p.L]])  # inputs [τ_ex, V], by hand
+    sys = control.ss(jac, B, np.eye(2), np.zeros((2, 2)))
+    T = np.linspace(0.0, 40.0 * _slowest_time_constant(jac), 2001)
+    U = np.vstack([np.full(T.size, torque), np.full(T.size, voltage)])
+    return np.asarray(control.forced_response(sys, T, U).outputs)[:, -1]
 
 
 def _normalised(num: np.ndarray, den: np.ndarray, length: int) -> tuple[np.ndarray, np.ndarray]:
@@ -174,19 +170,21 @@ def test_steady_state_matches_long_simulation(p: MotorParams, voltage: float, to
     np.testing.assert_allclose([omega, i], sim, rtol=1e-6, atol=1e-9)
 
 
-@settings(max_examples=20, deadline=None)
+@settings(max_examples=50, deadline=None)
 @given(
-    p=well_separated_motors(),
+    p=motor_params(),
     voltage=st.floats(-24.0, 24.0),
     torque=st.floats(-1.0, 1.0),
 )
-def test_steady_state_matches_long_simulation_random(
+def test_steady_state_matches_long_python_control_simulation(
     p: MotorParams, voltage: float, torque: float
 ):
     omega, i = steady_state(p, voltage, torque)
-    sim = _simulate_to_rest(p, voltage, torque)
+    sim = _forced_response_to_rest(p, voltage, torque)
+    # Stiff corners (R/L ~ 1e5 /s against K²/(JR) ~ 1e-5 /s) cost the exponential
+    # discretisation some digits; any error in Eq. (4.8) itself is O(1).
     scale = 1.0 + np.abs(sim).max()
-    np.testing.assert_allclose([omega, i], sim, rtol=1e-6, atol=1e-8 * scale)
+    np.testing.assert_allclose([omega, i], sim, rtol=1e-5, atol=1e-7 * scale)
 
 
 @pytest.mark.parametrize("p", [TABLE_4_1, TABLE_4_2], ids=["table4.1", "table4.2"])
@@ -200,9 +198,7 @@ def test_negative_external_torque_raises_current_eq_4_10(p: MotorParams):
     assert sim_loaded > sim_free
     assert i_loaded == pytest.approx(sim_loaded, rel=1e-6)
     # Eq. (4.10) with τ' = 0.4 N·m, by hand.
-    assert i_loaded == pytest.approx(
-        (p.K * 0.4 + p.b * 12.0) / (p.b * p.R + p.K**2), rel=1e-12
-    )
+    assert i_loaded == pytest.approx((p.K * 0.4 + p.b * 12.0) / (p.b * p.R + p.K**2), rel=1e-12)
 
 
 def test_steady_state_power_balance():

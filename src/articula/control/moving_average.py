@@ -14,23 +14,23 @@ def moving_average_push(buffer: np.ndarray, n: int, samples: np.ndarray, means: 
 
     `buffer` is (k, batch) and `samples`, `means` are (batch,). Eq. (4.17) prints a sum over
     k + 1 samples; we average the last k samples so that the filter has unit DC gain
-    (docs/deviations.md). Before k samples exist the mean is over the samples seen so far.
+    (docs/deviations.md). The buffer starts at zero, as in firmware: the samples before the
+    start count as 0 A, which they are for a motor at rest.
     """
     k, batch = buffer.shape
     slot = n % k
     for b in range(batch):
         buffer[slot, b] = samples[b]
         means[b] = 0.0
-    count = min(n + 1, k)
-    for j in range(count):
+    for j in range(k):
         for b in range(batch):
             means[b] += buffer[j, b]
     for b in range(batch):
-        means[b] /= count
+        means[b] /= k
 
 
 def moving_average(signal: np.ndarray, order: int) -> np.ndarray:
-    """The loop's causal moving average applied along the last axis of a whole signal."""
+    """The loop's causal moving average along the last axis of a whole signal (zero history)."""
     if order < 1:
         raise ConfigError("filter_order", f"must be >= 1 (got {order}); 1 means no filtering")
     x = np.asarray(signal, dtype=float)
@@ -38,5 +38,4 @@ def moving_average(signal: np.ndarray, order: int) -> np.ndarray:
     n = x.shape[-1]
     lagged = np.zeros_like(csum)
     lagged[..., order:] = csum[..., : max(n - order, 0)]
-    count = np.minimum(np.arange(1, n + 1), order)
-    return (csum - lagged) / count
+    return (csum - lagged) / order

@@ -17,6 +17,7 @@ Finite = Annotated[float, Field(allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 MAX_STEPS = 10_000_000
+MIN_STEADY_SAMPLES = 10
 
 
 class _Strict(BaseModel):
@@ -79,6 +80,20 @@ class CurrentControlConfig(_Strict):
             )
         if self.duration / self.dt > MAX_STEPS:
             raise ValueError(f"duration/dt is over {MAX_STEPS} steps; shorten duration or raise dt")
+        t = np.arange(self.steps) * self.dt
+        if self.steps - int(np.searchsorted(t, self.settle)) < MIN_STEADY_SAMPLES:
+            raise ValueError(
+                f"the steady-state window (duration − settle) holds fewer than "
+                f"{MIN_STEADY_SAMPLES} samples; lengthen duration or shorten settle"
+            )
+        ref = self.reference
+        if ref.amplitude > 0 and ref.frequency > 0:
+            period = 2 * np.pi / ref.frequency
+            if self.duration - self.settle < period:
+                raise ValueError(
+                    f"duration − settle ({self.duration - self.settle:g} s) is shorter than one "
+                    f"period of the reference ({period:.4g} s); lengthen duration"
+                )
         return self
 
     @property
@@ -125,7 +140,8 @@ def metric_window(config: CurrentControlConfig) -> MetricWindow:
     sinusoid = ref.amplitude > 0 and ref.frequency > 0
     return MetricWindow(
         settle_index=int(np.searchsorted(time_axis(config), config.settle)),
-        rise_target=float("nan") if sinusoid else ref.current,
+        # A step to zero, or a moving reference, has no rise time.
+        rise_target=float("nan") if sinusoid or ref.current == 0 else ref.current,
         frequency=ref.frequency if sinusoid else 0.0,
     )
 

@@ -1,4 +1,4 @@
-"""Time-response metrics on sampled signals, vectorised over a leading trial axis."""
+"""Trace-based time-response metrics: the independent oracle for the loop's streaming metrics."""
 
 from __future__ import annotations
 
