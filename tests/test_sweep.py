@@ -24,7 +24,7 @@ BASE = {"experiment": "motor.current", "duration": 0.5, "settle": 0.2}
 SPEC = {
     "base": BASE,
     "grid": {"seed": [0, 1], "controller.filter_order": [1, 4]},
-    "runs": [{}, {"reference": {"amplitude": 0.1, "frequency": 20.0}}],
+    "runs": [{}, {"reference": {"amplitude": 0.1, "frequency": 40.0}}],
 }
 
 
@@ -83,7 +83,7 @@ def test_expand_sweep_count_order_and_contents():
     spec = {
         "base": {**BASE, "reference": {"current": 0.5}},
         "grid": {"controller.filter_order": [1, 2, 3], "seed": [0, 1]},
-        "runs": [{"reference": {"amplitude": 0.1, "frequency": 5.0}}, {"rig": "single"}],
+        "runs": [{"reference": {"amplitude": 0.1, "frequency": 25.0}}, {"rig": "single"}],
     }
     configs = runner.expand_sweep(spec)
     assert len(configs) == 3 * 2 * 2
@@ -91,7 +91,7 @@ def test_expand_sweep_count_order_and_contents():
         (c["controller"]["filter_order"], c["seed"], c["rig"], c["reference"]["frequency"])
         for c in configs
     ]
-    runs = [("dual", 5.0), ("single", 0.0)]
+    runs = [("dual", 25.0), ("single", 0.0)]
     want = [(k, s, *r) for k, s, r in itertools.product([1, 2, 3], [0, 1], runs)]
     assert got == want  # Cartesian product of the grid, each point with every run, in order
     for c in configs:
@@ -188,11 +188,11 @@ def test_expand_sweep_does_not_mutate_its_input():
     spec = {
         "base": BASE,
         "runs": [{"reference": {"amplitude": 0.1}}],
-        "grid": {"reference.frequency": [1.0, 2.0]},
+        "grid": {"reference.frequency": [30.0, 40.0]},
     }
     before = copy.deepcopy(spec)
     configs = runner.expand_sweep(spec)
-    assert [c["reference"]["frequency"] for c in configs] == [1.0, 2.0]
+    assert [c["reference"]["frequency"] for c in configs] == [30.0, 40.0]
     assert spec == before
 
 

@@ -31,8 +31,10 @@ def config_error_from(exc: ValidationError, where: str = "") -> ConfigError:
         return ConfigError(field, "unknown key; remove it or check its spelling")
     if first["type"] == "missing":
         return ConfigError(field, "required key is missing")
-    got = first.get("input")
-    return ConfigError(field, f"{first['msg']} (got {got!r})")
+    message = str(first["msg"]).removeprefix("Value error, ")
+    if not first["loc"]:  # a check across fields: the input is the whole table
+        return ConfigError(field, message)
+    return ConfigError(field, f"{message} (got {first.get('input')!r})")
 
 
 def load_toml(path: Path) -> dict[str, Any]:
