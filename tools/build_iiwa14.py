@@ -27,6 +27,7 @@ ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "src/articula/robots/data/iiwa14/meshes"
 VERTICES = ROOT / "tests/data/iiwa14_mesh_vertices.npz"
 MAX_PLANES = 60
+PAD = 1e-6  # [m]
 
 
 def outward_hull(points: np.ndarray, planes: int = MAX_PLANES) -> np.ndarray:
@@ -52,7 +53,8 @@ def outward_hull(points: np.ndarray, planes: int = MAX_PLANES) -> np.ndarray:
                 centers[j] = c / np.linalg.norm(c)
     axes = np.vstack([np.eye(3), -np.eye(3)])  # keep the bounding box tight
     directions = np.vstack([centers, axes])
-    offsets = (points @ directions.T).max(axis=0)
+    # 1 µm of padding keeps every vertex inside once the corners are rounded to float32 (STL).
+    offsets = (points @ directions.T).max(axis=0) + PAD
     interior = points[hull.vertices].mean(axis=0)
     halfspaces = np.hstack([directions, -offsets[:, None]])
     corners = HalfspaceIntersection(halfspaces, interior).intersections

@@ -25,7 +25,7 @@ def bounding_capsule(vertices: np.ndarray) -> Capsule:
     """
     pts = np.asarray(vertices, dtype=float)
     mean = pts.mean(axis=0)
-    _, _, vt = np.linalg.svd(pts - mean, full_matrices=False)
+    _, _, vt = np.linalg.svd(pts - mean, full_matrices=True)  # three axes even for few points
     axis = vt[0]
     t = (pts - mean) @ axis
     rho = np.linalg.norm((pts - mean) - np.outer(t, axis), axis=1)

@@ -36,7 +36,8 @@ def load_mesh(path: Path, scale: float | tuple[float, float, float] = 1.0) -> tr
     factor = np.broadcast_to(np.asarray(scale, dtype=float), (3,))
     if not np.all(np.isfinite(factor)) or np.any(factor == 0):
         raise GeometryError(f"{path}: scale must be finite and non-zero (got {scale})")
-    return trimesh.Trimesh(vertices * factor, np.asarray(loaded.faces), process=False)
+    # Processing merges the duplicate corners of STL triangle soups into a connected mesh.
+    return trimesh.Trimesh(vertices * factor, np.asarray(loaded.faces), process=True)
 
 
 def convex_parts(

@@ -8,7 +8,7 @@ from typing import Annotated, Any
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from articula.errors import ConfigError
+from articula.errors import ConfigError, GeometryError
 from articula.geometry.meshes import convex_parts, load_mesh
 from articula.geometry.poses import pose
 from articula.geometry.shapes import ConvexShape, box, capsule, cylinder, sphere
@@ -97,7 +97,12 @@ def build_scene(
             _path(base_dir, r.urdf or ""), [_path(base_dir, d) for d in r.package_dirs], r.ee_frame
         )
     q0 = robot.check_q(r.q0 if r.q0 is not None else np.zeros(robot.nq), "robot.q0")
-    obstacles = [_obstacle(o, i, base_dir) for i, o in enumerate(spec.obstacles)]
+    obstacles = []
+    for i, o in enumerate(spec.obstacles):
+        try:
+            obstacles.append(_obstacle(o, i, base_dir))
+        except GeometryError as exc:
+            raise ConfigError(f"obstacles[{i}] ({o.name or f'obstacle_{i}'})", str(exc)) from None
     return Scene(robot, obstacles, broadphase=broadphase, metric=metric), q0
 
 
