@@ -231,17 +231,26 @@ class Scene:
         return [r.min_distance for r in self._bound_results]
 
     def _min_broadphase(self, q: np.ndarray, t: float) -> float:
-        lower = self._lower_bounds(q, t)
-        pin.updateGeometryPlacements(self.robot.model, self.robot.data, self._geo.exact,
-                                     self._exact_data)  # fmt: skip
-        exact = self._exact
+        # The hot path of the planner: attribute lookups are hoisted, _exact is inlined.
+        if self._moving:
+            self._move_obstacles(t)
+        model, data = self.robot.model, self.robot.data
+        pin.computeDistances(model, data, self._geo.bounds, self._bounds_data, q)
+        lower = [r.min_distance for r in self._bound_results]
+        exact_model, exact_data = self._geo.exact, self._exact_data
+        pin.updateGeometryPlacements(model, data, exact_model, exact_data)
+        requests, results = self._requests, self._results
         best = np.inf
         # Visit pairs by increasing lower bound; none after the first bound above the best
         # exact distance so far can be the minimum.
         for p in sorted(range(len(lower)), key=lower.__getitem__):
             if lower[p] >= best:
                 break
-            d = exact(p)
+            request = requests[p]
+            request.cached_support_func_guess = _NO_SUPPORT_GUESS  # as in _exact
+            request.cached_gjk_guess = _NO_GJK_GUESS
+            pin.computeDistance(exact_model, exact_data, p)
+            d = results[p].min_distance
             if d < best:
                 best = d
         return float(best)
