@@ -106,11 +106,14 @@ class Scene:
                 ]
             )
         cells = []
+        static = []  # pairs whose placements never change: world-fixed link, still obstacle
         for g_link, li in link_geoms:
             for oi, parts in enumerate(self._obstacle_geoms):
                 for g_obstacle in parts:
                     geo.pair(g_link, g_obstacle)
                     cells.append((li, oi))
+                    fixed = geo.exact.geometryObjects[g_link].parentJoint == 0
+                    static.append(fixed and not self.obstacles[oi].moving)
         self._geo = geo
         self._cells = np.array(cells, dtype=np.int64).reshape(-1, 2)
         self._exact_data = pin.GeometryData(geo.exact)
@@ -125,6 +128,16 @@ class Scene:
         self._trees = [cKDTree(s.vertices) for s in geo.shapes]
         self._moving = [oi for oi, o in enumerate(self.obstacles) if o.moving]
         self._shape = (len(robot.links), len(self.obstacles))
+        # The broad phase computes static pairs once and leaves them out of every query.
+        self._place(np.zeros(robot.nq), 0.0)
+        self._static_min = min(
+            (self._exact(p) for p, fixed in enumerate(static) if fixed), default=np.inf
+        )
+        self._dynamic = [p for p, fixed in enumerate(static) if not fixed]
+        self._dynamic_bounds = [self._bound_results[p] for p in self._dynamic]
+        for p, fixed in enumerate(static):
+            if fixed:
+                self._bounds_data.deactivateCollisionPair(p)
 
     # ----- queries -----------------------------------------------------------------------------
 
@@ -223,12 +236,16 @@ class Scene:
         return out
 
     def _lower_bounds(self, q: np.ndarray, t: float) -> list[float]:
-        """Capsule-capsule distances of every pair (lower bounds of the exact ones); also runs
-        the forward kinematics the exact placements then reuse."""
+        """Capsule-capsule distances of every pair (lower bounds of the exact ones; -inf for the
+        static pairs, which the bounds model skips); also runs the forward kinematics that the
+        exact placements then reuse."""
         self._move_obstacles(t)
         pin.computeDistances(self.robot.model, self.robot.data, self._geo.bounds,
                              self._bounds_data, q)  # fmt: skip
-        return [r.min_distance for r in self._bound_results]
+        lower = [-np.inf] * len(self._bound_results)  # static pairs: no bound, always exact
+        for p, r in zip(self._dynamic, self._dynamic_bounds, strict=True):
+            lower[p] = r.min_distance
+        return lower
 
     def _min_broadphase(self, q: np.ndarray, t: float) -> float:
         # The hot path of the planner: attribute lookups are hoisted, _exact is inlined.
@@ -236,16 +253,17 @@ class Scene:
             self._move_obstacles(t)
         model, data = self.robot.model, self.robot.data
         pin.computeDistances(model, data, self._geo.bounds, self._bounds_data, q)
-        lower = [r.min_distance for r in self._bound_results]
+        lower = [r.min_distance for r in self._dynamic_bounds]
         exact_model, exact_data = self._geo.exact, self._exact_data
         pin.updateGeometryPlacements(model, data, exact_model, exact_data)
-        requests, results = self._requests, self._results
-        best = np.inf
+        requests, results, dynamic = self._requests, self._results, self._dynamic
+        best = self._static_min
         # Visit pairs by increasing lower bound; none after the first bound above the best
         # exact distance so far can be the minimum.
-        for p in sorted(range(len(lower)), key=lower.__getitem__):
-            if lower[p] >= best:
+        for i in sorted(range(len(lower)), key=lower.__getitem__):
+            if lower[i] >= best:
                 break
+            p = dynamic[i]
             request = requests[p]
             request.cached_support_func_guess = _NO_SUPPORT_GUESS  # as in _exact
             request.cached_gjk_guess = _NO_GJK_GUESS
