@@ -7,7 +7,7 @@ of the robot, Figs. 1.11-1.12 style). Configurations: random joint vectors withi
 limits with the robot clear of both obstacles (the planner's usual situation). For each, the
 median time of one call:
   min_distance_us    Scene.min_distance(q), no broad phase (every pair by GJK/EPA)
-  broadphase_us      Scene.min_distance(q) with the bounding-sphere broad phase (default)
+  broadphase_us      Scene.min_distance(q) with the bounding-capsule broad phase (default)
   bare_coal_us       the same work written as a bare loop: Pinocchio forward kinematics, then
                      coal.distance on every (link, obstacle) pair from Python
   vertex_formula_us  the book's Sect. 1.3.3 closest-vertex-pair formula (metric="vertex")
@@ -63,7 +63,6 @@ def bare_coal_loop(scene):
     model, data = robot.model, robot.data
     links = []
     for link in robot.links:
-        frame = model.frames[link.frame_id]
         for shape, T in zip(link.shapes, link.placements, strict=True):
             links.append((link.frame_id, pin.SE3(T), shape.geometry, coal.Transform3s()))
     obstacles = []
@@ -74,7 +73,6 @@ def bare_coal_loop(scene):
     request = coal.DistanceRequest()
     request.enable_signed_distance = True
     result = coal.DistanceResult()
-    del frame
 
     def min_distance(q: np.ndarray) -> float:
         pin.framesForwardKinematics(model, data, q)

@@ -189,9 +189,22 @@ BAD_ARGS = {
     "current_inf": (["--preset", "table4.2", "--current", "inf"], ["--current"]),
     "torque_minus_inf": (["--preset", "table4.2", "--torque=-inf"], ["--torque"]),
     "unknown_option": (["--preset", "table4.2", "--bogus", "1"], ["--bogus"]),
-    "infeasible_current": (["--preset", "table4.2", "--current", "2"], ["current"]),
-    "infeasible_at_zero_voltage": (["--preset", "table4.1", "--voltage", "0"], ["current"]),
 }
+
+
+@pytest.mark.parametrize(
+    "args",
+    [["--preset", "table4.2", "--current", "2"], ["--preset", "table4.1", "--voltage", "0"]],
+    ids=["infeasible_current", "infeasible_at_zero_voltage"],
+)
+def test_motor_analyze_infeasible_current_keeps_the_rest(cli, args):
+    # No speed lets that current flow: omega_c is null with a reason; the model is still shown.
+    proc = cli("motor", "analyze", *args, "--json")
+    assert proc.returncode == 0, proc.stderr
+    result = json.loads(proc.stdout)
+    assert result["omega_c"] is None
+    assert "--current" in result["omega_c_note"]
+    assert len(result["poles"]) == 2 and set(result["steady_state"]) >= {"omega", "i"}
 
 
 def _fill(args: list[str], tmp_path: Path) -> list[str]:
@@ -415,3 +428,28 @@ def test_errors_are_one_line_even_for_long_messages(cli, tmp_path, assert_one_li
     )
     line = assert_one_line_error(cli("run", path, "--out", tmp_path / "o"), "settle", "duration")
     assert line.startswith("error: ")
+
+
+def test_run_out_under_a_file_is_one_line(
+    cli, tmp_path, write_toml, tiny_config, assert_one_line_error
+):
+    blocker = tmp_path / "afile"
+    blocker.write_text("x")
+    proc = cli("run", write_toml(tiny_config), "--out", blocker / "sub", "--json")
+    assert_one_line_error(proc, "--out")
+
+
+def test_params_file_that_is_not_utf8_is_one_line(cli, tmp_path, assert_one_line_error):
+    path = tmp_path / "bin.toml"
+    path.write_bytes(b"\xff\xfeR = 1\n")
+    proc = cli("motor", "analyze", "--params", path, "--json")
+    assert_one_line_error(proc, "bin.toml")
+
+
+def test_reference_the_supply_cannot_reach_is_rejected(capsys, tmp_path, write_toml, tiny_config):
+    # 1.5 A at 5 rad/s needs 1.5·8.35 + 0.4485·5 = 14.8 V, more than the 12 V supply (Eq. 4.13).
+    config = write_toml({**tiny_config, "reference": {"current": 1.5}})
+    with pytest.raises(SystemExit) as exc:
+        main(["run", str(config), "--out", str(tmp_path / "out"), "--json"])
+    assert exc.value.code == 2
+    assert "reference" in capsys.readouterr().err

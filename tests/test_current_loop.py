@@ -372,15 +372,10 @@ def test_bad_configs_raise_config_error(fields: dict):
     "reference", [{}, {"amplitude": 0.1, "frequency": 5.0}], ids=["step", "sinusoid"]
 )
 @pytest.mark.filterwarnings("ignore:invalid value encountered:RuntimeWarning")
-def test_config_with_empty_steady_window_is_rejected_or_measured(reference: dict):
+def test_config_with_empty_steady_window_is_rejected(reference: dict):
     fields = {"duration": 2.0, "settle": 1.9995, "reference": reference}
-    try:
-        cfg = parse_model(CurrentControlConfig, fields)
-    except ConfigError:
-        return
-    result = run_current_control(cfg)
-    assert math.isfinite(result.metrics["steady_state_error"])
-    assert math.isfinite(result.metrics["speed_mean"])
+    with pytest.raises(ConfigError):
+        parse_model(CurrentControlConfig, fields)
 
 
 def test_zero_step_has_no_rise_time():

@@ -217,7 +217,7 @@ def test_atomic_write_replaces_with_a_temporary_file_beside_the_target(tmp_path,
         real_replace(src, dst)
 
     monkeypatch.setattr(records.os, "replace", spy)
-    records._atomic_write(path, b"new")
+    records.atomic_write(path, b"new")
     assert path.read_bytes() == b"new"
     [(src, dst, data)] = seen
     assert dst == path
@@ -265,7 +265,7 @@ def test_atomic_write_failure_keeps_old_file_and_leaves_no_temp(
         monkeypatch.setattr(records.os, "fdopen", HalfWriter)
 
     with pytest.raises(type(error)):
-        records._atomic_write(path, b'{"new": true, "padding": "' + b"x" * 10_000 + b'"}')
+        records.atomic_write(path, b'{"new": true, "padding": "' + b"x" * 10_000 + b'"}')
     assert path.read_bytes() == b'{"old": true}'
     assert sorted(p.name for p in tmp_path.iterdir()) == ["record.json"]
 
@@ -276,20 +276,20 @@ def test_atomic_write_failure_on_a_new_file_leaves_nothing(tmp_path, monkeypatch
 
     monkeypatch.setattr(records.os, "replace", boom)
     with pytest.raises(OSError):
-        records._atomic_write(tmp_path / "x.parquet", b"data")
+        records.atomic_write(tmp_path / "x.parquet", b"data")
     assert list(tmp_path.iterdir()) == []
 
 
 def test_write_run_failing_midway_does_not_mark_the_run_finished(tmp_path, monkeypatch):
     folder = tmp_path / "run"
-    real = records._atomic_write
+    real = records.atomic_write
 
     def failing(path, data):
         if path.name == records.TRACE:
             raise OSError("disk full")
         real(path, data)
 
-    monkeypatch.setattr(records, "_atomic_write", failing)
+    monkeypatch.setattr(records, "atomic_write", failing)
     with pytest.raises(OSError):
         records.write_run(folder, {"experiment": "e"}, {"metrics": {}}, {"t": np.zeros(2)})
     assert not records.is_finished(folder)

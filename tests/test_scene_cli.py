@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 import shutil
 from pathlib import Path
@@ -272,3 +273,11 @@ def test_relative_mesh_paths_start_at_the_scene_file(tmp_path, monkeypatch, chec
     moved = check_in_process(Path("elsewhere/two_obstacles.toml"))
     original = check_in_process(TWO_OBSTACLES)
     assert moved["link_clearance"] == original["link_clearance"]
+
+
+def test_scene_check_reports_joint_limits(cli):
+    inside = json.loads(cli("scene", "check", TWO_OBSTACLES, "--json").stdout)
+    assert inside["within_limits"] is True
+    q = "0,0,0,0,0,0,3.1"
+    outside = json.loads(cli("scene", "check", TWO_OBSTACLES, "--q", q, "--json").stdout)
+    assert outside["within_limits"] is False  # joint 7 is limited to ±175° = ±3.054 rad

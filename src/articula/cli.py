@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import sys
 from pathlib import Path
 from typing import Annotated, Any
@@ -77,7 +78,9 @@ def run(
 def sweep(
     spec: Annotated[Path, typer.Argument(help="Sweep file (TOML with base, grid, runs).")],
     out_dir: OutDir,
-    workers: Annotated[int, typer.Option(min=1, help="Local worker processes.")] = 1,
+    workers: Annotated[
+        int, typer.Option(min=1, help="Local worker processes (default: one per core).")
+    ] = os.cpu_count() or 1,
     dask: Annotated[
         str | None, typer.Option(help="'local' for a loopback LocalCluster, or tcp://HOST:PORT.")
     ] = None,
@@ -156,7 +159,10 @@ def motor_analyze(
         out.print(f"{k:>13}: num {tf['num']}  den {tf['den']}")
     out.print(f"steady state at V={voltage} V, τ_ex={torque} N·m: "
               f"ω = {ss['omega']:.6g} rad/s, i = {ss['i']:.6g} A")  # fmt: skip
-    out.print(f"ω_c at V={voltage} V, i={current} A: {result['omega_c']:.6g} rad/s")
+    if result["omega_c"] is None:
+        out.print(f"ω_c: none ({result['omega_c_note']})")
+    else:
+        out.print(f"ω_c at V={voltage} V, i={current} A: {result['omega_c']:.6g} rad/s")
 
 
 @scene_app.command("check")

@@ -13,6 +13,7 @@ class ConfigError(ArticulaError, ValueError):
     def __init__(self, field: str, problem: str) -> None:
         self.field = field
         self.problem = problem
+        self.loc: tuple[str, ...] | None = None  # path inside a config, when validation knows it
         super().__init__(f"{field}: {problem}")
 
 

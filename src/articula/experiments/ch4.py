@@ -5,13 +5,14 @@ from __future__ import annotations
 from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
 from articula.control.current_loop import LoopSettings, MetricWindow, simulate_loop
 from articula.experiments.registry import Result, register
 from articula.plants.dc_motor import PRESETS, MotorParams, feedforward_voltage
 from articula.plants.motor_rig import discretize, rig_matrices
 from articula.plants.motor_sensors import CurrentSensorParams, EncoderParams
+from articula.validation import StrictModel
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
@@ -20,11 +21,7 @@ MAX_STEPS = 10_000_000
 MIN_STEADY_SAMPLES = 10
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(frozen=True, extra="forbid", strict=True)
-
-
-class ReferenceConfig(_Strict):
+class ReferenceConfig(StrictModel):
     """Current reference i_ref(t) = current + amplitude·sin(frequency·t) and the shaft speed."""
 
     current: Finite = 1.0  # i_ss [A]
@@ -33,7 +30,7 @@ class ReferenceConfig(_Strict):
     frequency: NonNegative = 0.0  # [rad/s]
 
 
-class CurrentControllerConfig(_Strict):
+class CurrentControllerConfig(StrictModel):
     """PI gains of Eq. (4.14) and the moving-average order of Eq. (4.17) (1 = unfiltered)."""
 
     kp: NonNegative = 10.0  # [V/A]
@@ -41,21 +38,21 @@ class CurrentControllerConfig(_Strict):
     filter_order: Annotated[int, Field(ge=1, le=10_000)] = 1
 
 
-class SpeedControllerConfig(_Strict):
+class SpeedControllerConfig(StrictModel):
     """PI gains of the secondary motor's speed loop, Eq. (4.12); the book gives none."""
 
     kp: NonNegative = 5.0  # [V·s/rad]
     ki: NonNegative = 10.0  # [V/rad]
 
 
-class PwmConfig(_Strict):
+class PwmConfig(StrictModel):
     """Motor driver: supply V_max and duty register bits N of Eq. (4.15) (0 = ideal driver)."""
 
     bits: Annotated[int, Field(ge=0, le=16)] = 8
     v_max: Positive = 12.0  # [V]
 
 
-class CurrentControlConfig(_Strict):
+class CurrentControlConfig(StrictModel):
     """One closed-loop current-control run of Sect. 4.4."""
 
     seed: Annotated[int, Field(ge=0)] = 0
@@ -70,7 +67,7 @@ class CurrentControlConfig(_Strict):
     speed_controller: SpeedControllerConfig = SpeedControllerConfig()
     pwm: PwmConfig = PwmConfig()
     sensor: CurrentSensorParams = CurrentSensorParams()
-    encoder: EncoderParams = EncoderParams(window=50)
+    encoder: EncoderParams = EncoderParams()
 
     @model_validator(mode="after")
     def _check_times(self) -> CurrentControlConfig:
@@ -87,6 +84,13 @@ class CurrentControlConfig(_Strict):
                 f"{MIN_STEADY_SAMPLES} samples; lengthen duration or shorten settle"
             )
         ref = self.reference
+        peak = ref.current + ref.amplitude
+        needed = feedforward_voltage(self.params, peak, ref.speed)  # Eq. (4.13) at the peak
+        if self.rig == "dual" and needed > self.pwm.v_max:
+            raise ValueError(
+                f"reference: {peak:g} A at {ref.speed:g} rad/s needs {needed:.3g} V, more than "
+                f"v_max = {self.pwm.v_max:g} V; lower reference.current, amplitude or speed"
+            )
         if ref.amplitude > 0 and ref.frequency > 0:
             period = 2 * np.pi / ref.frequency
             if self.duration - self.settle < period:

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from articula.errors import ConfigError
+from articula.errors import ConfigError, InfeasibleError
 from articula.plants.dc_motor import (
     PRESETS,
     MotorParams,
@@ -37,6 +37,11 @@ def analyze(p: MotorParams, voltage: float, torque: float, current: float) -> di
     A, B = state_space(p)
     omega, i = steady_state(p, voltage, torque)
     eig = poles(p)
+    try:
+        omega_c: float | None = critical_speed(p, voltage, current)
+        omega_c_note = ""
+    except InfeasibleError as exc:
+        omega_c, omega_c_note = None, str(exc)
     return {
         "params": p.model_dump(),
         "A": A.tolist(),
@@ -44,7 +49,8 @@ def analyze(p: MotorParams, voltage: float, torque: float, current: float) -> di
         "poles": [_complex(z) for z in eig],
         "transfer": {k: {"num": n, "den": d} for k, (n, d) in transfer_matrix(p).items()},
         "steady_state": {"omega": omega, "i": i, "voltage": voltage, "torque": torque},
-        "omega_c": critical_speed(p, voltage, current),
+        "omega_c": omega_c,  # None when --current cannot flow even at standstill
+        "omega_c_note": omega_c_note,
     }
 
 

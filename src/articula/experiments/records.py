@@ -18,20 +18,24 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import tomli_w
 
+from articula import __version__
 from articula.errors import ConfigError
 from articula.experiments.registry import Result
 
 RECORD = "record.json"
 CONFIG = "config.toml"
 TRACE = "trace.parquet"
-_UMASK = os.umask(0)
-os.umask(_UMASK)
 _VERSIONED = ("articula", "numpy", "scipy", "numba", "control", "pyarrow", "pydantic")
 
 
 def config_hash(config: Mapping[str, Any]) -> str:
-    """Short stable hash of a config mapping; names its run folder inside a sweep."""
-    canonical = json.dumps(config, sort_keys=True, separators=(",", ":"))
+    """Short stable hash of a config mapping and the articula version; names its run folder.
+
+    The version is hashed too, so that a sweep resumed after an upgrade recomputes its runs
+    instead of mixing results of two versions of the code.
+    """
+    payload = {"config": dict(config), "articula": __version__}
+    canonical = json.dumps(payload, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(canonical.encode()).hexdigest()[:12]
 
 
@@ -68,19 +72,22 @@ def write_run(
     make_folder(folder)
     for stale in folder.glob(".*.tmp"):  # left by a run killed while writing
         stale.unlink(missing_ok=True)
-    _atomic_write(folder / CONFIG, tomli_w.dumps(dict(config)).encode())
+    atomic_write(folder / CONFIG, tomli_w.dumps(dict(config)).encode())
     table = pa.table({k: np.asarray(v) for k, v in trace.items()})
     sink = pa.BufferOutputStream()
     pq.write_table(table, sink)
-    _atomic_write(folder / TRACE, sink.getvalue().to_pybytes())
-    _atomic_write(folder / RECORD, json.dumps(record, indent=2).encode())
+    atomic_write(folder / TRACE, sink.getvalue().to_pybytes())
+    atomic_write(folder / RECORD, json.dumps(record, indent=2).encode())
 
 
 def make_folder(path: Path) -> None:
     """Create an output folder, with a clear error when a file is in the way."""
     if path.exists() and not path.is_dir():
         raise ConfigError("--out", f"{path} is a file; give a folder path")
-    path.mkdir(parents=True, exist_ok=True)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError("--out", f"cannot create {path} ({exc.strerror})") from None
 
 
 def is_finished(folder: Path) -> bool:
@@ -97,10 +104,10 @@ def write_table(path: Path, table: pa.Table) -> None:
     """Write a Parquet table atomically."""
     sink = pa.BufferOutputStream()
     pq.write_table(table, sink)
-    _atomic_write(path, sink.getvalue().to_pybytes())
+    atomic_write(path, sink.getvalue().to_pybytes())
 
 
-def _atomic_write(path: Path, data: bytes) -> None:
+def atomic_write(path: Path, data: bytes) -> None:
     """Write to a temporary file beside `path`, flush it to disk, then rename over `path`."""
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
@@ -108,7 +115,7 @@ def _atomic_write(path: Path, data: bytes) -> None:
             f.write(data)
             f.flush()
             os.fsync(f.fileno())
-        os.chmod(tmp, 0o666 & ~_UMASK)  # mkstemp creates 0600; give the usual mode
+        os.chmod(tmp, 0o644)  # mkstemp creates 0600; results are meant to be shared
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

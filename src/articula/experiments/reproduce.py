@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from articula.errors import ConfigError
-from articula.experiments.records import make_folder, package_versions
+from articula.experiments.records import atomic_write, make_folder, package_versions
 
 Progress = Callable[[int, int], None]
 # A chapter section runs its experiments into OUT/<chapter>/ and returns its markdown.
@@ -55,7 +55,7 @@ def reproduce(
         title, section = sections[name]
         parts += [f"## {title}", "", section(out / name, full, workers, notify), ""]
     report = out / "report.md"
-    report.write_text("\n".join(parts))
+    atomic_write(report, "\n".join(parts).encode())
     return {
         "report": str(report),
         "chapters": chosen,

@@ -5,9 +5,10 @@ from __future__ import annotations
 from typing import Annotated
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from articula.errors import InfeasibleError
+from articula.validation import StrictModel
 
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
@@ -17,10 +18,8 @@ NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 DEFAULT_INDUCTANCE = 10e-3
 
 
-class MotorParams(BaseModel):
+class MotorParams(StrictModel):
     """Motor constants in SI: R [Ω], K = K_t = K_e [N·m/A], b [N·m·s/rad], J [kg·m²], L [H]."""
-
-    model_config = ConfigDict(frozen=True, extra="forbid", strict=True)
 
     R: Positive
     K: Positive
@@ -78,7 +77,7 @@ def critical_speed(p: MotorParams, voltage: float, current: float) -> float:
     omega_c = (voltage - current * p.R) / p.K  # ω_c = (V − i_ss R) / K, Sect. 4.3.2
     if omega_c <= 0:
         raise InfeasibleError(
-            f"current: {current} A needs more than {voltage} V even at standstill "
+            f"--current/--voltage: {current} A needs more than {voltage} V even at standstill "
             f"(i·R = {current * p.R:.3g} V); lower the current or raise the voltage"
         )
     return omega_c

@@ -6,15 +6,15 @@ import math
 from typing import Annotated
 
 from numba import njit
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field, model_validator
+
+from articula.validation import StrictModel
 
 PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 
 
-class CurrentSensorParams(BaseModel):
+class CurrentSensorParams(StrictModel):
     """ACS712-5A read by the Arduino's ADC; `ideal` bypasses noise and quantisation."""
-
-    model_config = ConfigDict(frozen=True, extra="forbid", strict=True)
 
     ideal: bool = False
     sensitivity: PositiveFloat = 0.185  # [V/A], ACS712-5A datasheet
@@ -23,20 +23,26 @@ class CurrentSensorParams(BaseModel):
     adc_bits: Annotated[int, Field(ge=1, le=24)] = 10
     adc_vref: PositiveFloat = 5.0  # [V]
 
+    @model_validator(mode="after")
+    def _zero_inside_adc_range(self) -> CurrentSensorParams:
+        if self.zero_voltage >= self.adc_vref:
+            raise ValueError(
+                f"zero_voltage ({self.zero_voltage} V) must lie below adc_vref ({self.adc_vref} V)"
+            )
+        return self
+
     @property
     def noise_sigma(self) -> float:
         """Standard deviation [V] of the output noise, taking peak-to-peak as 6σ."""
         return self.noise_pp / 6.0
 
 
-class EncoderParams(BaseModel):
+class EncoderParams(StrictModel):
     """Shaft encoder; speed is the count difference over a window of samples."""
-
-    model_config = ConfigDict(frozen=True, extra="forbid", strict=True)
 
     ideal: bool = False
     counts_per_rev: Annotated[int, Field(ge=1)] = 375
-    window: Annotated[int, Field(ge=1, le=100_000)] = 20  # samples
+    window: Annotated[int, Field(ge=1, le=100_000)] = 50  # samples (50 ms at 1 kHz)
 
 
 @njit(cache=True, error_model="numpy")

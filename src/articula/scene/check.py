@@ -41,5 +41,6 @@ def check_scene(path: Path, q_text: str | None = None, metric: str = "gjk") -> d
             o.name: float(col.min()) for o, col in zip(scene.obstacles, d.T, strict=True)
         },
         "collides": bool(min_clearance < 0.0),
+        "within_limits": bool(np.all((q >= scene.robot.lower) & (q <= scene.robot.upper))),
         "metric": metric,
     }

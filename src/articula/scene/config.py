@@ -6,7 +6,7 @@ from pathlib import Path
 from typing import Annotated, Any
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
 from articula.errors import ConfigError, GeometryError
 from articula.geometry.meshes import convex_parts, load_mesh
@@ -15,7 +15,7 @@ from articula.geometry.shapes import ConvexShape, box, capsule, cylinder, sphere
 from articula.robots.model import RobotModel
 from articula.scene.obstacles import Obstacle
 from articula.scene.scene import Metric, Scene
-from articula.validation import parse_model
+from articula.validation import StrictModel, parse_model
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
@@ -25,16 +25,12 @@ PositivePair = Annotated[list[Positive], Field(min_length=2, max_length=2)]
 SHAPE_KEYS = ("mesh", "box", "sphere", "cylinder", "capsule")
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(frozen=True, extra="forbid", strict=True)
-
-
-class RobotSpec(_Strict):
+class RobotSpec(StrictModel):
     """[robot]: a built-in robot or a URDF, and its initial configuration q0 [rad]."""
 
     builtin: str | None = None
     urdf: str | None = None
-    package_dirs: list[str] = []
+    package_dirs: list[str] = Field(default_factory=list)
     ee_frame: str | None = None
     q0: list[Finite] | None = None
 
@@ -45,7 +41,7 @@ class RobotSpec(_Strict):
         return self
 
 
-class ObstacleSpec(_Strict):
+class ObstacleSpec(StrictModel):
     """[[obstacles]]: one shape (mesh file or primitive) with a pose; sizes in m."""
 
     name: str | None = None
@@ -56,8 +52,8 @@ class ObstacleSpec(_Strict):
     sphere: Positive | None = None
     cylinder: PositivePair | None = None  # [radius, length]
     capsule: PositivePair | None = None  # [radius, length]
-    position: Vec3 = [0.0, 0.0, 0.0]
-    rpy: Vec3 = [0.0, 0.0, 0.0]
+    position: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    rpy: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
     velocity: Vec3 | None = None  # [m/s]: the obstacle moves at constant velocity
 
     @model_validator(mode="after")
@@ -70,11 +66,11 @@ class ObstacleSpec(_Strict):
         return self
 
 
-class SceneSpec(_Strict):
+class SceneSpec(StrictModel):
     """A whole scene file."""
 
     robot: RobotSpec
-    obstacles: list[ObstacleSpec] = []
+    obstacles: list[ObstacleSpec] = Field(default_factory=list)
 
 
 def load_scene_spec(data: dict[str, Any], where: str = "") -> SceneSpec:

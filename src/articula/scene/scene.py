@@ -185,7 +185,7 @@ class Scene:
         return arr
 
     def _move_obstacles(self, t: float) -> None:
-        """Put moving obstacles (exact shapes and bounding spheres) at their pose at time t."""
+        """Put moving obstacles (exact shapes and bounding capsules) at their pose at time t."""
         for oi in self._moving:
             world = pin.SE3(self.obstacles[oi].pose_at(t))
             for g in self._obstacle_geoms[oi]:
