@@ -1,0 +1,1 @@
+"""Chapter 1 planning: reference trajectories, the objective of Eq. (1.13), BAORNN."""

@@ -1,0 +1,62 @@
+"""BAORNN (Algorithm 1): beetle-antennae search over joint angles, one time-step at a time."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from articula.errors import ConfigError
+from articula.planning.objective import Objective
+
+
+@dataclass(frozen=True)
+class BaornnParams:
+    """Antenna length λ_k = c1·√g_k (1.23) and step δ_k = c2·λ_k (1.24); iterations per period."""
+
+    c1: float = 0.5
+    c2: float = 0.5
+    iterations_per_step: int = 10
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.c1) and self.c1 > 0 and np.isfinite(self.c2) and self.c2 > 0):
+            raise ConfigError("planner.c1/c2", f"must be finite and > 0 (got {self.c1}, {self.c2})")
+        if self.iterations_per_step < 1:
+            raise ConfigError("planner.iterations_per_step", "must be >= 1")
+
+
+@dataclass
+class Baornn:
+    """The faithful algorithm of Sect. 1.3.1; all randomness from the injected generator."""
+
+    objective: Objective
+    params: BaornnParams
+    rng: np.random.Generator
+    evaluations: int = field(default=0, init=False)
+
+    def iterate(
+        self, q: np.ndarray, g: float, x_ref: np.ndarray, t: float
+    ) -> tuple[np.ndarray, float]:
+        """One iteration of Algorithm 1 from (q, g = g(q)); returns the accepted (q, g)."""
+        obj = self.objective
+        b = self.rng.standard_normal(q.size)
+        b /= np.linalg.norm(b)  # a normalised random direction
+        lam = self.params.c1 * np.sqrt(g) if np.isfinite(g) else self.params.c1  # Eq. (1.23)
+        q_left = obj.project(q + lam * b, q, t)  # Eqs. (1.15)-(1.17)
+        q_right = obj.project(q - lam * b, q, t)
+        g_left = obj.value(q_left, x_ref, t)  # Eq. (1.18)
+        g_right = obj.value(q_right, x_ref, t)
+        delta = self.params.c2 * lam  # Eq. (1.24)
+        q_new = obj.project(q - delta * np.sign(g_left - g_right) * b, q, t)  # Eq. (1.19)
+        g_new = obj.value(q_new, x_ref, t)  # Eq. (1.20)
+        self.evaluations += 3
+        if g_new < g:  # Eqs. (1.21)-(1.22): accept only an improvement
+            return q_new, g_new
+        return q, g
+
+    def step(self, q: np.ndarray, x_ref: np.ndarray, t: float) -> tuple[np.ndarray, float]:
+        """One control period: re-evaluate g for the new reference, then iterate."""
+        g = self.objective.value(q, x_ref, t)
+        for _ in range(self.params.iterations_per_step):
+            q, g = self.iterate(q, g, x_ref, t)
+        return q, g

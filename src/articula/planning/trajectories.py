@@ -1,0 +1,110 @@
+"""Task-space reference paths x_r(t) [m]: circle (1.27), rectangle, waypoints, CSV."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from articula.errors import ConfigError
+
+
+def _vector(name: str, value: Sequence[float], shape: tuple[int, ...]) -> np.ndarray:
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != shape or not np.all(np.isfinite(arr)):
+        raise ConfigError(name, f"needs finite numbers of shape {shape} (got {arr.shape})")
+    return arr
+
+
+def _positive(name: str, value: float) -> float:
+    if not (np.isfinite(value) and value > 0):
+        raise ConfigError(name, f"must be a finite positive number (got {value})")
+    return float(value)
+
+
+@dataclass(frozen=True)
+class Circle:
+    """x_r(t) = C + r cos(2πt/T) A + r sin(2πt/T) B, Eq. (1.27); A, B orthonormal."""
+
+    center: np.ndarray
+    axis_a: np.ndarray
+    axis_b: np.ndarray
+    radius: float
+    period: float
+
+    @classmethod
+    def create(
+        cls, center: Sequence[float], axis_a: Sequence[float], axis_b: Sequence[float],
+        radius: float, period: float,
+    ) -> Circle:  # fmt: skip
+        """A validated circle: A and B must be perpendicular unit vectors."""
+        a = _vector("trajectory.axis_a", axis_a, (3,))
+        b = _vector("trajectory.axis_b", axis_b, (3,))
+        if not (np.isclose(a @ a, 1) and np.isclose(b @ b, 1) and abs(a @ b) < 1e-9):
+            raise ConfigError("trajectory.axis_a/axis_b", "must be perpendicular unit vectors")
+        center_ = _vector("trajectory.center", center, (3,))
+        radius_ = _positive("trajectory.radius", radius)
+        return cls(center_, a, b, radius_, _positive("trajectory.period", period))
+
+    def __call__(self, t: float) -> np.ndarray:
+        """Reference point [m] at time t [s]."""
+        phase = 2.0 * np.pi * t / self.period
+        return self.center + self.radius * (
+            np.cos(phase) * self.axis_a + np.sin(phase) * self.axis_b
+        )  # Eq. (1.27)
+
+
+@dataclass(frozen=True)
+class Waypoints:
+    """Straight lines between points [m] reached at increasing times [s]; held after the last."""
+
+    points: np.ndarray
+    times: np.ndarray
+
+    @classmethod
+    def create(cls, points: Sequence[Sequence[float]], times: Sequence[float]) -> Waypoints:
+        """Validated waypoints: at least two, finite, times strictly increasing."""
+        p = np.asarray(points, dtype=float)
+        t = np.asarray(times, dtype=float)
+        if p.ndim != 2 or p.shape[1] != 3 or len(p) < 2:
+            raise ConfigError("trajectory.points", f"needs two or more [x, y, z] (got {p.shape})")
+        if t.shape != (len(p),):
+            raise ConfigError("trajectory.times", f"needs {len(p)} times, one per point")
+        if not (np.all(np.isfinite(p)) and np.all(np.isfinite(t))):
+            raise ConfigError("trajectory", "points and times must be finite numbers")
+        if np.any(np.diff(t) <= 0):
+            raise ConfigError("trajectory.times", "must be strictly increasing")
+        return cls(p, t)
+
+    @classmethod
+    def from_csv(cls, path: Path) -> Waypoints:
+        """Waypoints from a CSV file with the header t,x,y,z."""
+        if not Path(path).is_file():
+            raise ConfigError("trajectory.path", f"{path}: file not found")
+        try:
+            data = np.genfromtxt(path, delimiter=",", names=True)
+        except ValueError as exc:
+            raise ConfigError("trajectory.path", f"{path}: not a numeric CSV ({exc})") from None
+        names = data.dtype.names or ()
+        if set(names) != {"t", "x", "y", "z"}:
+            raise ConfigError("trajectory.path", f"{path}: needs columns t, x, y, z (got {names})")
+        data = np.atleast_1d(data)
+        return cls.create(np.column_stack([data["x"], data["y"], data["z"]]), data["t"])
+
+    def __call__(self, t: float) -> np.ndarray:
+        """Reference point [m] at time t [s]."""
+        return np.array([np.interp(t, self.times, self.points[:, i]) for i in range(3)])
+
+
+def rectangle(vertices: Sequence[Sequence[float]], period: float) -> Waypoints:
+    """The closed path through four vertices at constant speed, once per `period` [s]."""
+    v = _vector("trajectory.vertices", vertices, (4, 3))
+    T = _positive("trajectory.period", period)
+    loop = np.vstack([v, v[:1]])
+    lengths = np.linalg.norm(np.diff(loop, axis=0), axis=1)
+    if np.any(lengths <= 0):
+        raise ConfigError("trajectory.vertices", "consecutive vertices must differ")
+    times = np.concatenate([[0.0], np.cumsum(lengths)]) / lengths.sum() * T
+    return Waypoints.create(loop, times)
