@@ -165,6 +165,26 @@ def motor_analyze(
         out.print(f"ω_c at V={voltage} V, i={current} A: {result['omega_c']:.6g} rad/s")
 
 
+@app.command()
+def plan(
+    scene_file: Annotated[Path, typer.Argument(help="Scene file with [trajectory], [planner].")],
+    out_dir: OutDir,
+    as_json: JsonFlag = False,
+) -> None:
+    """Track the scene's reference path with BAORNN; writes a run folder (trace + record)."""
+    from articula.experiments.ch1_plan import plan_to_folder
+
+    record = plan_to_folder(scene_file, out_dir)
+    if as_json:
+        _emit_json(record)
+        return
+    m = record["metrics"]
+    out.print(f"RMS error after {m['settle_s']:g} s: {1e3 * m['rms_error']:.3f} mm, max "
+              f"{1e3 * m['max_error']:.3f} mm; min clearance {m['min_clearance']:.4f} m; "
+              f"collisions {int(m['collisions'])}; {m['time_per_iteration_us']:.1f} µs per "
+              f"iteration; written to {out_dir}")  # fmt: skip
+
+
 @scene_app.command("check")
 def scene_check(
     scene_file: Annotated[

@@ -25,7 +25,10 @@ from articula.experiments.registry import Result
 RECORD = "record.json"
 CONFIG = "config.toml"
 TRACE = "trace.parquet"
-_VERSIONED = ("articula", "numpy", "scipy", "numba", "control", "pyarrow", "pydantic")
+_VERSIONED = (
+    "articula", "numpy", "scipy", "numba", "control", "pyarrow", "pydantic",
+    "pin", "coal", "trimesh",
+)  # fmt: skip
 
 
 def config_hash(config: Mapping[str, Any]) -> str:

@@ -1,0 +1,155 @@
+"""`articula plan`: a scene file with [trajectory] and [planner] tables, tracked by BAORNN."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import numpy as np
+from pydantic import Field, model_validator
+
+from articula.errors import ConfigError
+from articula.experiments import records
+from articula.experiments.registry import Result
+from articula.planning.baornn import Baornn, BaornnParams
+from articula.planning.objective import Objective
+from articula.planning.track import PlanResult, track
+from articula.planning.trajectories import Circle, Waypoints, rectangle
+from articula.scene.config import build_scene, load_scene_spec
+from articula.validation import StrictModel, load_toml, parse_model
+
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+Vec3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
+
+
+class TrajectorySpec(StrictModel):
+    """[trajectory]: circle (Eq. 1.27), rectangle, waypoints or csv."""
+
+    type: Literal["circle", "rectangle", "waypoints", "csv"]
+    center: Vec3 | None = None
+    axis_a: Vec3 | None = None
+    axis_b: Vec3 | None = None
+    radius: Positive | None = None
+    period: Positive | None = None
+    vertices: list[Vec3] | None = None
+    points: list[Vec3] | None = None
+    times: list[Finite] | None = None
+    path: str | None = None
+
+    @model_validator(mode="after")
+    def _fields_of_type(self) -> TrajectorySpec:
+        needed = {
+            "circle": ("center", "axis_a", "axis_b", "radius", "period"),
+            "rectangle": ("vertices", "period"),
+            "waypoints": ("points", "times"),
+            "csv": ("path",),
+        }[self.type]
+        missing = [k for k in needed if getattr(self, k) is None]
+        if missing:
+            raise ValueError(f"type = {self.type!r} needs {', '.join(missing)}")
+        return self
+
+
+class PlannerSpec(StrictModel):
+    """[planner]: the method and its parameters (Eqs. 1.11-1.13, 1.23-1.24)."""
+
+    method: Literal["baornn"] = "baornn"
+    lambda_weight: NonNegative = 0.0  # Λ of Eq. (1.11)
+    beta: NonNegative = 1.0
+    d_min: NonNegative = 0.0  # [m], Eq. (1.12)
+    dt: Positive = 0.01  # [s] control period
+    iterations_per_step: Annotated[int, Field(ge=1, le=10_000)] = 10
+    duration: Positive = 50.0  # [s]
+    settle: NonNegative = 5.0  # [s] before rms_error and max_error are taken
+    c1: Positive = 0.5
+    c2: Positive = 0.5
+    seed: Annotated[int, Field(ge=0)] = 0
+
+    @model_validator(mode="after")
+    def _times(self) -> PlannerSpec:
+        if self.settle >= self.duration:
+            raise ValueError("settle must be shorter than duration")
+        return self
+
+
+def make_trajectory(spec: TrajectorySpec, base_dir: Path) -> Circle | Waypoints:
+    """The reference path a TrajectorySpec names; CSV paths are relative to `base_dir`."""
+    if spec.type == "circle":
+        return Circle.create(spec.center or [], spec.axis_a or [], spec.axis_b or [],
+                             spec.radius or 0.0, spec.period or 0.0)  # fmt: skip
+    if spec.type == "rectangle":
+        return rectangle(spec.vertices or [], spec.period or 0.0)
+    if spec.type == "waypoints":
+        return Waypoints.create(spec.points or [], spec.times or [])
+    path = Path(spec.path or "")
+    return Waypoints.from_csv(path if path.is_absolute() else base_dir / path)
+
+
+def plan(scene_file: Path) -> tuple[dict[str, Any], Result, float]:
+    """Run the planner of a scene file: (full config, metrics and trace, wall time [s])."""
+    data = load_toml(scene_file)
+    unknown = set(data) - {"robot", "obstacles", "trajectory", "planner"}
+    if unknown:
+        raise ConfigError(
+            sorted(unknown)[0], "unknown table; use robot, obstacles, trajectory, planner"
+        )
+    if "trajectory" not in data:
+        raise ConfigError(f"{scene_file}: trajectory", "the [trajectory] table is missing")
+    trajectory_spec = parse_model(TrajectorySpec, data["trajectory"], f"{scene_file}: trajectory")
+    planner_spec = parse_model(PlannerSpec, data.get("planner", {}), f"{scene_file}: planner")
+    scene, q0 = build_scene(load_scene_spec(data, str(scene_file)), scene_file.parent)
+    trajectory = make_trajectory(trajectory_spec, scene_file.parent)
+    p = planner_spec
+    objective = Objective(scene, p.lambda_weight, p.beta, p.d_min)
+    planner = Baornn(objective, BaornnParams(p.c1, p.c2, p.iterations_per_step),
+                     np.random.default_rng(p.seed))  # fmt: skip
+    start = time.perf_counter()
+    result = track(planner, trajectory, q0, p.dt, p.duration)
+    wall = time.perf_counter() - start
+    config = {
+        "experiment": "baornn.plan",
+        "seed": p.seed,
+        **{k: v for k, v in data.items() if k in ("robot", "obstacles")},
+        "trajectory": trajectory_spec.model_dump(mode="json", exclude_none=True),
+        "planner": planner_spec.model_dump(mode="json"),
+    }
+    iterations = planner.evaluations / 3
+    metrics = _metrics(result, scene.robot, p.settle, wall, iterations)
+    return config, Result(metrics, _trace(result)), wall
+
+
+def _metrics(
+    r: PlanResult, robot: Any, settle: float, wall: float, iterations: float
+) -> dict[str, float]:
+    """rms_error and max_error after `settle` [s], clearance, collisions, limits, speed."""
+    late = r.error[r.t >= settle]
+    outside = (r.q < robot.lower) | (r.q > robot.upper)
+    return {
+        "settle_s": settle,
+        "rms_error": float(np.sqrt(np.mean(late**2))),
+        "max_error": float(late.max()),
+        "min_clearance": float(r.clearance.min()),
+        "collisions": float(np.sum(r.clearance <= 0.0)),
+        "joint_limit_violations": float(np.sum(np.any(outside, axis=1))),
+        "time_per_iteration_us": 1e6 * wall / max(iterations, 1.0),
+    }
+
+
+def _trace(r: PlanResult) -> dict[str, np.ndarray]:
+    trace = {"t": r.t}
+    trace.update({f"q_{j + 1}": r.q[:, j] for j in range(r.q.shape[1])})
+    trace.update({"x": r.x[:, 0], "y": r.x[:, 1], "z": r.x[:, 2]})
+    trace.update({"x_ref": r.x_ref[:, 0], "y_ref": r.x_ref[:, 1], "z_ref": r.x_ref[:, 2]})
+    trace.update({"error": r.error, "clearance": r.clearance})
+    return trace
+
+
+def plan_to_folder(scene_file: Path, out: Path) -> dict[str, Any]:
+    """Run a scene file's planner and write its run folder; returns the record."""
+    config, result, wall = plan(scene_file)  # bad input fails here, before any file is written
+    record = records.build_record(config, result, wall)
+    records.write_run(out, config, record, result.trace)
+    return record
