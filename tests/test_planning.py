@@ -70,12 +70,16 @@ def test_objective_is_tracking_error_plus_inverse_distance_penalty():
 def test_projection_clips_to_limits_and_refuses_points_too_close():
     scene = Scene(ROBOT, [Obstacle("ball", (sphere(0.1),), pose([0.4, 0.3, 0.6]))])
     objective = Objective(scene, 0.001, 1.0, d_min=0.05)
-    current = np.zeros(7)
+    current, x_ref = np.zeros(7), np.array([0.3, 0.2, 0.7])
+    g_current = objective.value(current, x_ref)
     far = np.full(7, 10.0)
-    assert np.allclose(objective.project(far, current), ROBOT.upper)
+    q, g = objective.project_and_value(far, current, g_current, x_ref, 0.0)
+    assert np.allclose(q, ROBOT.upper)
+    assert g == pytest.approx(objective.value(ROBOT.upper, x_ref))
     near = np.array([0.6, 1.0, 0.0, -0.6, 0.0, 0.0, 0.0])
     assert scene.min_distance(near) < 0.05
-    assert objective.project(near, current) is current  # Eq. (1.17): stay where you are
+    q, g = objective.project_and_value(near, current, g_current, x_ref, 0.0)
+    assert q is current and g == g_current  # Eq. (1.17): stay where you are
 
 
 def test_objective_never_increases_within_a_period():

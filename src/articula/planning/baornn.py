@@ -42,13 +42,12 @@ class Baornn:
         b = self.rng.standard_normal(q.size)
         b /= np.linalg.norm(b)  # a normalised random direction
         lam = self.params.c1 * np.sqrt(g) if np.isfinite(g) else self.params.c1  # Eq. (1.23)
-        q_left = obj.project(q + lam * b, q, t)  # Eqs. (1.15)-(1.17)
-        q_right = obj.project(q - lam * b, q, t)
-        g_left = obj.value(q_left, x_ref, t)  # Eq. (1.18)
-        g_right = obj.value(q_right, x_ref, t)
+        # Eqs. (1.15)-(1.18): antennae, projected onto Ω, evaluated by "virtual robots".
+        _, g_left = obj.project_and_value(q + lam * b, q, g, x_ref, t)
+        _, g_right = obj.project_and_value(q - lam * b, q, g, x_ref, t)
         delta = self.params.c2 * lam  # Eq. (1.24)
-        q_new = obj.project(q - delta * np.sign(g_left - g_right) * b, q, t)  # Eq. (1.19)
-        g_new = obj.value(q_new, x_ref, t)  # Eq. (1.20)
+        step = q - delta * np.sign(g_left - g_right) * b  # Eq. (1.19)
+        q_new, g_new = obj.project_and_value(step, q, g, x_ref, t)  # Eq. (1.20)
         self.evaluations += 3
         if g_new < g:  # Eqs. (1.21)-(1.22): accept only an improvement
             return q_new, g_new

@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
 from articula.errors import ConfigError
 from articula.scene.scene import Scene
@@ -37,25 +38,38 @@ class Objective:
 
     def value(self, q: np.ndarray, x_ref: np.ndarray, t: float = 0.0) -> float:
         """Objective g at configuration q [rad] for the reference point x_ref [m]."""
-        self.scene.robot.forward(q)
-        x = self.scene.robot.data.oMf[self.scene.robot.ee_frame_id].translation
-        g = float(np.linalg.norm(x_ref - x))  # Eq. (1.5)
+        d = self.scene.min_distance(q, t) if self.needs_distance else np.inf
+        return self._value(q, x_ref, d)
+
+    def project_and_value(
+        self, q: np.ndarray, q_current: np.ndarray, g_current: float, x_ref: np.ndarray, t: float
+    ) -> tuple[np.ndarray, float]:
+        """(P_Ω(q), g there), Eqs. (1.17)-(1.18): clip to the joint limits (1.9); if the clipped
+        point is closer than d_min to an obstacle, stay at (q_current, g_current). One distance
+        query serves both the constraint and the penalty."""
+        clipped = self._clip(q)
+        if not self.needs_distance:
+            return clipped, self._value(clipped, x_ref, np.inf)
+        d = self.scene.min_distance(clipped, t)  # also leaves the joint placements updated
+        if d < self.d_min:
+            return q_current, g_current
+        return clipped, self._value(clipped, x_ref, d, kinematics_done=True)
+
+    def _clip(self, q: np.ndarray) -> np.ndarray:
+        model = self.scene.robot.model
+        return np.minimum(np.maximum(q, model.lowerPositionLimit), model.upperPositionLimit)
+
+    def _value(
+        self, q: np.ndarray, x_ref: np.ndarray, d: float, kinematics_done: bool = False
+    ) -> float:
+        robot = self.scene.robot
+        if kinematics_done:
+            # min_distance ran the forward kinematics: only the end-effector frame is missing.
+            pin.updateFramePlacement(robot.model, robot.data, robot.ee_frame_id)
+        else:
+            robot.forward(q)
+        g = float(np.linalg.norm(x_ref - robot.data.oMf[robot.ee_frame_id].translation))  # (1.5)
         if self.lambda_weight > 0 and self.scene.obstacles:
-            d = self.scene.min_distance(q, t)
             # Eq. (1.7): inside an obstacle the penalty has no finite value.
             g += self.lambda_weight / d**self.beta if d > 0 else np.inf
         return g
-
-    def project(self, q: np.ndarray, q_current: np.ndarray, t: float = 0.0) -> np.ndarray:
-        """P_Ω of Eq. (1.17): clip to the joint limits (1.9); keep q_current if d < d_min."""
-        robot = self.scene.robot
-        clipped = np.minimum(
-            np.maximum(q, robot.model.lowerPositionLimit), robot.model.upperPositionLimit
-        )
-        if (
-            self.needs_distance
-            and self.d_min > 0
-            and self.scene.min_distance(clipped, t) < self.d_min
-        ):
-            return q_current
-        return clipped
