@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -40,7 +41,7 @@ class Baornn:
         """One iteration of Algorithm 1 from (q, g = g(q)); returns the accepted (q, g)."""
         obj = self.objective
         b = self.rng.standard_normal(q.size)
-        b /= np.linalg.norm(b)  # a normalised random direction
+        b /= math.sqrt(b @ b)  # a normalised random direction
         lam = self.params.c1 * np.sqrt(g) if np.isfinite(g) else self.params.c1  # Eq. (1.23)
         # Eqs. (1.15)-(1.18): antennae, projected onto Ω, evaluated by "virtual robots".
         _, g_left = obj.project_and_value(q + lam * b, q, g, x_ref, t)
