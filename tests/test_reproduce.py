@@ -33,7 +33,8 @@ def ch4(cli, one_json, tmp_path_factory):
 def test_summary_is_one_json_object(ch4):
     out, summary = ch4
     assert summary["report"] == str(out / "report.md")
-    assert summary["chapters"] == ["ch4"]
+    assert list(summary["chapters"]) == ["ch4"]
+    assert summary["chapters"]["ch4"]["omega_c"] == pytest.approx(8.1382, abs=1e-4)
     assert summary["mode"] == "quick"
     assert summary["wall_time_s"] >= 0
 

@@ -48,8 +48,10 @@ BOOK_OMEGA_MAX, BOOK_CURRENT_MAX = 33.72, 0.18  # Eq. (4.9)
 BOOK_OMEGA_C = 8.1382  # Sect. 4.3.2, Table 4.2 at 12 V and 1 A
 
 
-def ch4_section(out: Path, full: bool, workers: int, progress: Progress) -> str:
-    """Run chapter 4 into `out` and return its markdown."""
+def ch4_section(
+    out: Path, full: bool, workers: int, progress: Progress
+) -> tuple[str, dict[str, Any]]:
+    """Run chapter 4 into `out`; returns its markdown and its headline numbers."""
     out.mkdir(parents=True, exist_ok=True)
     sweep_file = _packaged("bandwidth_full.toml" if full else "bandwidth_quick.toml")
     sweep_configs = runner.expand_sweep(load_toml(sweep_file))
@@ -61,7 +63,13 @@ def ch4_section(out: Path, full: bool, workers: int, progress: Progress) -> str:
         out, sweep_file, sweep_configs, workers,
         lambda done, _n: progress(len(FIGURES) + done, total),
     )  # fmt: skip
-    return "\n".join(lines)
+    w1, i1 = steady_state(TABLE_4_1, 1.0)
+    numbers = {
+        "omega_c": critical_speed(TABLE_4_2, 12.0, 1.0),
+        "omega_ss_per_volt": w1,
+        "i_ss_per_volt": i1,
+    }
+    return "\n".join(lines), numbers
 
 
 def _packaged(name: str) -> Path:

@@ -11,8 +11,9 @@ from articula.errors import ConfigError
 from articula.experiments.records import atomic_write, make_folder, package_versions
 
 Progress = Callable[[int, int], None]
-# A chapter section runs its experiments into OUT/<chapter>/ and returns its markdown.
-Section = Callable[[Path, bool, int, Progress], str]
+# A chapter section runs its experiments into OUT/<chapter>/ and returns its markdown and the
+# numbers that `reproduce --json` reports under chapters.<name>.
+Section = Callable[[Path, bool, int, Progress], tuple[str, dict[str, Any]]]
 
 
 def _sections() -> dict[str, tuple[str, Section]]:
@@ -51,14 +52,16 @@ def reproduce(
         "Versions: " + ", ".join(f"{k} {v}" for k, v in package_versions().items()) + ".",
         "",
     ]
+    chapters: dict[str, dict[str, Any]] = {}
     for name in chosen:
         title, section = sections[name]
-        parts += [f"## {title}", "", section(out / name, full, workers, notify), ""]
+        markdown, chapters[name] = section(out / name, full, workers, notify)
+        parts += [f"## {title}", "", markdown, ""]
     report = out / "report.md"
     atomic_write(report, "\n".join(parts).encode())
     return {
         "report": str(report),
-        "chapters": chosen,
+        "chapters": chapters,
         "mode": "full" if full else "quick",
         "wall_time_s": time.perf_counter() - start,
     }

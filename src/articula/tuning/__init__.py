@@ -1,0 +1,1 @@
+"""Model-free tuning: search controller parameters by running experiments."""
