@@ -9,14 +9,20 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from articula.errors import ConfigError
+from articula.errors import ConfigError, InfeasibleError
 from articula.experiments import records
 from articula.experiments.registry import Result
 from articula.planning.baornn import Baornn, BaornnParams
+from articula.planning.baornn_improved import ImprovedBaornn, ImprovedParams
 from articula.planning.objective import Objective
+from articula.planning.planner import Planner
+from articula.planning.qp_ik import QpIk, QpIkParams
+from articula.planning.reach import check_reach
 from articula.planning.track import PlanResult, track
 from articula.planning.trajectories import Circle, Waypoints, rectangle
+from articula.planning.velocity_ik import VelocityIk, VelocityIkParams
 from articula.scene.config import build_scene, load_scene_spec
+from articula.scene.scene import Scene
 from articula.validation import StrictModel, load_toml, parse_model
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
@@ -53,10 +59,18 @@ class TrajectorySpec(StrictModel):
         return self
 
 
-class PlannerSpec(StrictModel):
-    """[planner]: the method and its parameters (Eqs. 1.11-1.13, 1.23-1.24)."""
+Method = Literal["baornn", "baornn-improved", "pinv", "dls", "qp"]
 
-    method: Literal["baornn"] = "baornn"
+
+class PlannerSpec(StrictModel):
+    """[planner]: the method and its parameters; keys a method does not use are ignored.
+
+    BAORNN (both): lambda_weight Λ, beta β (Eq. 1.11), d_min (1.12), c1, c2 (1.23-1.24),
+    iterations_per_step, seed; baornn-improved also `pairs`. Baselines: gain K [1/s];
+    pinv/dls: repulsion η, influence [m], damping μ [m] (dls); qp: influence, safety [m].
+    """
+
+    method: Method = "baornn"
     lambda_weight: NonNegative = 0.0  # Λ of Eq. (1.11)
     beta: NonNegative = 1.0
     d_min: NonNegative = 0.0  # [m], Eq. (1.12)
@@ -64,15 +78,41 @@ class PlannerSpec(StrictModel):
     iterations_per_step: Annotated[int, Field(ge=1, le=10_000)] = 10
     duration: Positive = 50.0  # [s]
     settle: NonNegative = 5.0  # [s] before rms_error and max_error are taken
+    tolerance: Positive = 0.05  # [m] an rms_error above it means the path was not tracked
     c1: Positive = 0.5
     c2: Positive = 0.5
+    pairs: Annotated[int, Field(ge=1, le=64)] = 3
+    gain: NonNegative = 20.0
+    damping: NonNegative = 0.02
+    repulsion: NonNegative = 0.02
+    influence: Positive = 0.15
+    safety: NonNegative = 0.03
     seed: Annotated[int, Field(ge=0)] = 0
 
     @model_validator(mode="after")
     def _times(self) -> PlannerSpec:
         if self.settle >= self.duration:
             raise ValueError("settle must be shorter than duration")
+        if self.safety >= self.influence:
+            raise ValueError("safety must be smaller than influence")
         return self
+
+
+def make_planner(spec: PlannerSpec, scene: Scene) -> Planner:
+    """The planner a PlannerSpec names, on `scene`."""
+    rng = np.random.default_rng(spec.seed)
+    objective = Objective(scene, spec.lambda_weight, spec.beta, spec.d_min)
+    if spec.method == "baornn":
+        return Baornn(objective, BaornnParams(spec.c1, spec.c2, spec.iterations_per_step), rng)
+    if spec.method == "baornn-improved":
+        params = ImprovedParams(spec.c1, spec.c2, spec.pairs, spec.iterations_per_step)
+        return ImprovedBaornn(objective, params, rng)
+    if spec.method == "qp":
+        qp = QpIkParams(gain=spec.gain, influence=spec.influence, safety=spec.safety)
+        return QpIk(scene, spec.dt, qp, spec.d_min)
+    velocity = VelocityIkParams(gain=spec.gain, damping=spec.damping, repulsion=spec.repulsion,
+                                influence=spec.influence)  # fmt: skip
+    return VelocityIk(scene, spec.method, spec.dt, velocity, spec.d_min)
 
 
 def make_trajectory(spec: TrajectorySpec, base_dir: Path) -> Circle | Waypoints:
@@ -103,9 +143,8 @@ def plan(scene_file: Path) -> tuple[dict[str, Any], Result, float]:
     scene, q0 = build_scene(load_scene_spec(data, str(scene_file)), scene_file.parent)
     trajectory = make_trajectory(trajectory_spec, scene_file.parent)
     p = planner_spec
-    objective = Objective(scene, p.lambda_weight, p.beta, p.d_min)
-    planner = Baornn(objective, BaornnParams(p.c1, p.c2, p.iterations_per_step),
-                     np.random.default_rng(p.seed))  # fmt: skip
+    check_reach(scene.robot, trajectory, p.duration)
+    planner = make_planner(p, scene)
     start = time.perf_counter()
     result = track(planner, trajectory, q0, p.dt, p.duration)
     wall = time.perf_counter() - start
@@ -116,8 +155,13 @@ def plan(scene_file: Path) -> tuple[dict[str, Any], Result, float]:
         "trajectory": trajectory_spec.model_dump(mode="json", exclude_none=True),
         "planner": planner_spec.model_dump(mode="json"),
     }
-    iterations = planner.evaluations / 3
-    metrics = _metrics(result, scene.robot, p.settle, wall, iterations)
+    metrics = _metrics(result, scene.robot, p.settle, wall, planner.iterations)
+    if metrics["rms_error"] > p.tolerance:
+        raise InfeasibleError(
+            f"trajectory: not tracked: rms error {metrics['rms_error']:.4f} m after "
+            f"{p.settle} s (max {metrics['max_error']:.4f} m) exceeds planner.tolerance = "
+            f"{p.tolerance} m; the path may be out of reach or blocked"
+        )
     return config, Result(metrics, _trace(result)), wall
 
 

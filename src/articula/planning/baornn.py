@@ -9,6 +9,7 @@ import numpy as np
 
 from articula.errors import ConfigError
 from articula.planning.objective import Objective
+from articula.scene.scene import Scene
 
 
 @dataclass(frozen=True)
@@ -34,6 +35,17 @@ class Baornn:
     params: BaornnParams
     rng: np.random.Generator
     evaluations: int = field(default=0, init=False)
+    iterations: int = field(default=0, init=False)
+
+    @property
+    def scene(self) -> Scene:
+        """The scene of the objective."""
+        return self.objective.scene
+
+    @property
+    def d_min(self) -> float:
+        """The hard clearance [m] of the objective (Eq. 1.12)."""
+        return self.objective.d_min
 
     def iterate(
         self, q: np.ndarray, g: float, x_ref: np.ndarray, t: float
@@ -50,13 +62,14 @@ class Baornn:
         step = q - delta * np.sign(g_left - g_right) * b  # Eq. (1.19)
         q_new, g_new = obj.project_and_value(step, q, g, x_ref, t)  # Eq. (1.20)
         self.evaluations += 3
+        self.iterations += 1
         if g_new < g:  # Eqs. (1.21)-(1.22): accept only an improvement
             return q_new, g_new
         return q, g
 
-    def step(self, q: np.ndarray, x_ref: np.ndarray, t: float) -> tuple[np.ndarray, float]:
+    def step(self, q: np.ndarray, x_ref: np.ndarray, t: float) -> np.ndarray:
         """One control period: re-evaluate g for the new reference, then iterate."""
         g = self.objective.value(q, x_ref, t)
         for _ in range(self.params.iterations_per_step):
             q, g = self.iterate(q, g, x_ref, t)
-        return q, g
+        return q

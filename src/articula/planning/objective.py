@@ -42,23 +42,26 @@ class Objective:
         d = self.scene.min_distance(q, t) if self.needs_distance else np.inf
         return self._value(q, x_ref, d)
 
+    def tracking_error(self, q: np.ndarray, x_ref: np.ndarray) -> float:
+        """The tracking term ||x_r − f(θ)|| [m] of g alone, Eq. (1.5)."""
+        robot = self.scene.robot
+        robot.forward(q)
+        e = x_ref - robot.data.oMf[robot.ee_frame_id].translation
+        return math.sqrt(e @ e)
+
     def project_and_value(
         self, q: np.ndarray, q_current: np.ndarray, g_current: float, x_ref: np.ndarray, t: float
     ) -> tuple[np.ndarray, float]:
         """(P_Ω(q), g there), Eqs. (1.17)-(1.18): clip to the joint limits (1.9); if the clipped
         point is closer than d_min to an obstacle, stay at (q_current, g_current). One distance
         query serves both the constraint and the penalty."""
-        clipped = self._clip(q)
+        clipped = self.scene.robot.clip(q)
         if not self.needs_distance:
             return clipped, self._value(clipped, x_ref, np.inf)
         d = self.scene.min_distance(clipped, t)  # also leaves the joint placements updated
         if d < self.d_min:
             return q_current, g_current
         return clipped, self._value(clipped, x_ref, d, kinematics_done=True)
-
-    def _clip(self, q: np.ndarray) -> np.ndarray:
-        model = self.scene.robot.model
-        return np.minimum(np.maximum(q, model.lowerPositionLimit), model.upperPositionLimit)
 
     def _value(
         self, q: np.ndarray, x_ref: np.ndarray, d: float, kinematics_done: bool = False

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from articula.errors import ConfigError, InfeasibleError
-from articula.planning.baornn import Baornn
+from articula.planning.planner import Planner
 
 Trajectory = Callable[[float], np.ndarray]
 
@@ -26,20 +26,24 @@ class PlanResult:
 
 
 def track(
-    planner: Baornn, trajectory: Trajectory, q0: np.ndarray, dt: float, duration: float
+    planner: Planner, trajectory: Trajectory, q0: np.ndarray, dt: float, duration: float
 ) -> PlanResult:
     """Follow `trajectory` from q0 [rad] for `duration` [s], one planner step per `dt` [s]."""
     if not (np.isfinite(dt) and dt > 0 and np.isfinite(duration) and duration >= dt):
         raise ConfigError("planner.dt/duration", f"need 0 < dt <= duration (got {dt}, {duration})")
-    objective = planner.objective
-    scene, robot = objective.scene, objective.scene.robot
+    scene, robot = planner.scene, planner.scene.robot
     q = robot.check_q(q0, "robot.q0").copy()
     if np.any(q < robot.lower) or np.any(q > robot.upper):
         raise InfeasibleError("robot.q0: the start breaks the joint limits (Eq. 1.9)")
-    if scene.obstacles and scene.min_distance(q) <= objective.d_min:
-        raise InfeasibleError(
-            f"robot.q0: the start is within d_min = {objective.d_min} m of an obstacle (Eq. 1.12)"
-        )
+    if scene.obstacles:
+        d0 = scene.min_distance(q)
+        if d0 <= 0:
+            raise InfeasibleError(f"robot.q0: the start collides with an obstacle (d = {d0:.4f} m)")
+        if d0 <= planner.d_min:
+            raise InfeasibleError(
+                f"robot.q0: the start is {d0:.4f} m from an obstacle, within d_min = "
+                f"{planner.d_min} m (Eq. 1.12); lower d_min or move the start"
+            )
     steps = round(duration / dt)
     t = np.arange(steps) * dt
     qs = np.empty((steps, q.size))
@@ -48,7 +52,7 @@ def track(
     clearance = np.full(steps, np.inf)
     for n, tn in enumerate(t):
         x_ref[n] = trajectory(tn)
-        q, _ = planner.step(q, x_ref[n], tn)
+        q = planner.step(q, x_ref[n], tn)
         qs[n] = q
         x[n] = robot.ee_position(q)
         if scene.obstacles:

@@ -99,6 +99,16 @@ class RobotModel:
         """Upper joint limits [rad or m]."""
         return self.model.upperPositionLimit.copy()
 
+    @property
+    def velocity_limit(self) -> np.ndarray:
+        """Joint speed limits [rad/s or m/s] from the URDF."""
+        return self.model.velocityLimit.copy()
+
+    def clip(self, q: np.ndarray) -> np.ndarray:
+        """q clipped into the joint limits (the projection of Eq. 1.17)."""
+        return np.minimum(np.maximum(q, self.model.lowerPositionLimit),
+                          self.model.upperPositionLimit)  # fmt: skip
+
     def check_q(self, q: Sequence[float] | np.ndarray, field: str = "q") -> np.ndarray:
         """q as a float array of length nq, or ConfigError naming the problem."""
         if type(q) is np.ndarray and q.dtype == np.float64 and q.shape == (self.nq,):
@@ -140,6 +150,23 @@ class RobotModel:
         return pin.computeFrameJacobian(
             self.model, self.data, arr, self.ee_frame_id, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
         ).copy()
+
+    def point_jacobian(self, q: np.ndarray, frame_id: int, point: np.ndarray) -> np.ndarray:
+        """3×nq Jacobian of a world point [m] moving rigidly with frame `frame_id`.
+
+        v_p = v_o + ω × (p − o) at the parent joint's origin o, in world axes.
+        """
+        joint = self.model.frames[frame_id].parentJoint
+        pin.computeJointJacobians(self.model, self.data, q)
+        J = pin.getJointJacobian(
+            self.model, self.data, joint, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+        )
+        r = point - self.data.oMi[joint].translation
+        return J[:3] - _skew(r) @ J[3:]
+
+
+def _skew(v: np.ndarray) -> np.ndarray:
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
 def _check_serial(model: pin.Model, urdf: Path) -> None:

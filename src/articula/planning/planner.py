@@ -1,0 +1,32 @@
+"""What `track` needs from a planner: its scene, its hard clearance, and one control step."""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+
+from articula.scene.scene import Scene
+
+
+class Planner(Protocol):
+    """One control period at a time: from q [rad] toward the reference point x_ref [m]."""
+
+    @property
+    def scene(self) -> Scene:
+        """The robot and obstacles the planner plans in."""
+        ...
+
+    @property
+    def d_min(self) -> float:
+        """Hard minimum clearance [m] the start must respect (Eq. 1.12)."""
+        ...
+
+    @property
+    def iterations(self) -> int:
+        """Inner iterations (BAORNN) or solver calls (baselines) done so far."""
+        ...
+
+    def step(self, q: np.ndarray, x_ref: np.ndarray, t: float) -> np.ndarray:
+        """The configuration [rad] for time t [s]."""
+        ...

@@ -1,0 +1,47 @@
+"""Refuse a reference path that leaves the arm's reach before planning along it."""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Callable
+
+import numpy as np
+import pinocchio as pin
+
+from articula.errors import InfeasibleError
+from articula.robots.model import RobotModel
+
+
+def reach_sphere(robot: RobotModel) -> tuple[np.ndarray, float] | None:
+    """(centre [m], radius [m]) of a sphere containing every end-effector position, or None.
+
+    For a chain of revolute joints, the distance between successive joint origins (and from
+    the last joint to the end effector) is fixed, so the end effector stays within their sum
+    of the first joint's origin. A prismatic joint has no such bound.
+    """
+    model, data = robot.model, robot.model.createData()
+    if any("Prismatic" in joint.shortname() for joint in model.joints[1:]):
+        return None
+    pin.framesForwardKinematics(model, data, pin.neutral(model))
+    points = [data.oMi[j].translation for j in range(1, model.njoints)]
+    points.append(data.oMf[robot.ee_frame_id].translation)
+    radius = sum(float(np.linalg.norm(b - a)) for a, b in itertools.pairwise(points))
+    return points[0].copy(), radius
+
+
+def check_reach(
+    robot: RobotModel, trajectory: Callable[[float], np.ndarray], duration: float
+) -> None:
+    """InfeasibleError naming the first sampled time [s] at which the path is out of reach."""
+    sphere = reach_sphere(robot)
+    if sphere is None:
+        return
+    centre, radius = sphere
+    for t in np.linspace(0.0, duration, 2001):
+        distance = float(np.linalg.norm(trajectory(t) - centre))
+        if distance > radius:
+            raise InfeasibleError(
+                f"trajectory: unreachable: at t = {t:.2f} s the path is {distance:.3f} m from "
+                f"the first joint, beyond the arm's reach of {radius:.3f} m (the error cannot "
+                f"fall below {distance - radius:.3f} m)"
+            )

@@ -1,0 +1,82 @@
+"""Velocity-level baselines: Jacobian pseudo-inverse (JMPI) and damped least squares, with
+obstacle avoidance through a repulsion term projected into the null space of the task."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from articula.errors import ConfigError
+from articula.planning.clearance import clearance_rows
+from articula.planning.reference_velocity import reference_velocity
+from articula.scene.scene import Scene
+
+
+@dataclass(frozen=True)
+class VelocityIkParams:
+    """Gains of q̇ = J#(ẋ_r + K e) + (I − J⁺J) q̇_0.
+
+    gain K [1/s] on the position error; damping μ [m] of DLS, J# = Jᵀ(JJᵀ + μ²I)⁻¹;
+    repulsion η [m²/s] and influence distance [m] of the null-space term
+    q̇_0 = η Σ (1/d − 1/d_i)/d² ∇d (the gradient of the classic FIRAS potential); speed_scale
+    scales the URDF joint velocity limits.
+    """
+
+    gain: float = 20.0
+    damping: float = 0.02
+    repulsion: float = 0.02
+    influence: float = 0.15
+    speed_scale: float = 1.0
+
+    def __post_init__(self) -> None:
+        for name in ("gain", "damping", "repulsion", "influence", "speed_scale"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value >= 0):
+                raise ConfigError(f"planner.{name}", f"must be finite and >= 0 (got {value})")
+
+
+@dataclass
+class VelocityIk:
+    """Resolved-rate control of the end-effector position at control period dt [s]."""
+
+    scene: Scene
+    method: Literal["pinv", "dls"]
+    dt: float
+    params: VelocityIkParams = field(default_factory=VelocityIkParams)
+    d_min: float = 0.0
+    iterations: int = field(default=0, init=False)
+    _previous_ref: np.ndarray | None = field(default=None, init=False)
+
+    def step(self, q: np.ndarray, x_ref: np.ndarray, t: float) -> np.ndarray:
+        """One period: integrate q̇ for dt and clip to the joint limits."""
+        robot, p = self.scene.robot, self.params
+        x = robot.ee_position(q)
+        v = reference_velocity(x_ref, self._previous_ref, x, self.dt, p.gain)
+        self._previous_ref = x_ref.copy()
+        J = robot.jacobian(q)[:3]
+        J_pinv = np.linalg.pinv(J)
+        if self.method == "dls":
+            J_task = J.T @ np.linalg.solve(J @ J.T + p.damping**2 * np.eye(3), np.eye(3))
+        else:
+            J_task = J_pinv
+        qdot = J_task @ v + (np.eye(robot.nq) - J_pinv @ J) @ self._repulsion(q, t)
+        self.iterations += 1
+        return robot.clip(q + self.dt * _limit_speed(qdot, p.speed_scale * robot.velocity_limit))
+
+    def _repulsion(self, q: np.ndarray, t: float) -> np.ndarray:
+        p = self.params
+        if not self.scene.obstacles or p.repulsion == 0:
+            return np.zeros(q.size)
+        rows = clearance_rows(self.scene, q, t, p.influence)
+        d = np.maximum(rows.distance, 1e-3)  # inside an obstacle: push as hard as at 1 mm
+        weights = p.repulsion * (1.0 / d - 1.0 / p.influence) / d**2
+        return weights @ rows.gradient
+
+
+def _limit_speed(qdot: np.ndarray, limit: np.ndarray) -> np.ndarray:
+    """q̇ scaled down uniformly (direction kept) so that no joint exceeds its limit [rad/s];
+    a URDF limit of 0 means none was given."""
+    ratio = np.max(np.abs(qdot) / np.where(limit > 0, limit, np.inf))
+    return qdot / ratio if ratio > 1.0 else qdot
