@@ -130,18 +130,24 @@ def make_trajectory(spec: TrajectorySpec, base_dir: Path) -> Circle | Waypoints:
 
 def plan(scene_file: Path) -> tuple[dict[str, Any], Result, float]:
     """Run the planner of a scene file: (full config, metrics and trace, wall time [s])."""
-    data = load_toml(scene_file)
+    return plan_data(load_toml(scene_file), scene_file.parent, str(scene_file))
+
+
+def plan_data(
+    data: dict[str, Any], base_dir: Path, where: str
+) -> tuple[dict[str, Any], Result, float]:
+    """plan() for a scene mapping whose relative paths start at `base_dir`; errors name `where`."""
     unknown = set(data) - {"robot", "obstacles", "trajectory", "planner"}
     if unknown:
         raise ConfigError(
             sorted(unknown)[0], "unknown table; use robot, obstacles, trajectory, planner"
         )
     if "trajectory" not in data:
-        raise ConfigError(f"{scene_file}: trajectory", "the [trajectory] table is missing")
-    trajectory_spec = parse_model(TrajectorySpec, data["trajectory"], f"{scene_file}: trajectory")
-    planner_spec = parse_model(PlannerSpec, data.get("planner", {}), f"{scene_file}: planner")
-    scene, q0 = build_scene(load_scene_spec(data, str(scene_file)), scene_file.parent)
-    trajectory = make_trajectory(trajectory_spec, scene_file.parent)
+        raise ConfigError(f"{where}: trajectory", "the [trajectory] table is missing")
+    trajectory_spec = parse_model(TrajectorySpec, data["trajectory"], f"{where}: trajectory")
+    planner_spec = parse_model(PlannerSpec, data.get("planner", {}), f"{where}: planner")
+    scene, q0 = build_scene(load_scene_spec(data, where), base_dir)
+    trajectory = make_trajectory(trajectory_spec, base_dir)
     p = planner_spec
     check_reach(scene.robot, trajectory, p.duration)
     planner = make_planner(p, scene)
@@ -168,15 +174,19 @@ def plan(scene_file: Path) -> tuple[dict[str, Any], Result, float]:
 def _metrics(
     r: PlanResult, robot: Any, settle: float, wall: float, iterations: float
 ) -> dict[str, float]:
-    """rms_error and max_error after `settle` [s], clearance, collisions, limits, speed."""
-    late = r.error[r.t >= settle]
+    """rms_error and max_error after `settle` [s]; clearance [m] and colliding steps over the
+    whole run and after `settle` (the approach from q0 is the riskiest part); limits; speed."""
+    settled = r.t >= settle
+    late = r.error[settled]
     outside = (r.q < robot.lower) | (r.q > robot.upper)
     return {
         "settle_s": settle,
         "rms_error": float(np.sqrt(np.mean(late**2))),
         "max_error": float(late.max()),
         "min_clearance": float(r.clearance.min()),
+        "min_clearance_settled": float(r.clearance[settled].min()),
         "collisions": float(np.sum(r.clearance <= 0.0)),
+        "collisions_settled": float(np.sum(r.clearance[settled] <= 0.0)),
         "joint_limit_violations": float(np.sum(np.any(outside, axis=1))),
         "time_per_iteration_us": 1e6 * wall / max(iterations, 1.0),
     }

@@ -13,7 +13,7 @@ import control as ct
 import numpy as np
 
 from articula.control.current_loop_linear import bandwidth, closed_loop, first_crossing, is_stable
-from articula.experiments import runner
+from articula.experiments import records, runner
 from articula.experiments.ch4 import CurrentControlConfig, CurrentControllerConfig, loop_settings
 from articula.plants.dc_motor import (
     TABLE_4_1,
@@ -166,7 +166,7 @@ def _figure_runs(out: Path, tick: Callable[[int], None]) -> list[str]:
     for done, name in enumerate(FIGURES, start=1):
         raw = load_toml(_packaged(f"{name}.toml"))
         record = runner.run_to_folder(raw, out / "runs" / name)
-        trace = _read_trace(out / "runs" / name / "trace.parquet")
+        trace = records.read_trace(out / "runs" / name)
         config = configs[name] = parse_model(CurrentControlConfig, _without_experiment(raw))
         response(trace, FIGURES[name], out / f"{name}.png", config.pwm.bits)
         results[name] = {**record["metrics"], "k": config.controller.filter_order}
@@ -367,13 +367,6 @@ def _bandwidth_verdict(rows: list[dict[str, Any]]) -> str:
 
 def _without_experiment(raw: dict[str, Any]) -> dict[str, Any]:
     return {k: v for k, v in raw.items() if k != "experiment"}
-
-
-def _read_trace(path: Path) -> dict[str, np.ndarray]:
-    import pyarrow.parquet as pq
-
-    table = pq.read_table(path)
-    return {name: table[name].to_numpy() for name in table.column_names}
 
 
 def _ms(x: float | None) -> str:

@@ -103,6 +103,12 @@ def read_record(folder: Path) -> dict[str, Any]:
     return json.loads((folder / RECORD).read_text())
 
 
+def read_trace(folder: Path) -> dict[str, np.ndarray]:
+    """The trace.parquet of a run folder as columns."""
+    table = pq.read_table(folder / "trace.parquet")
+    return {name: table[name].to_numpy() for name in table.column_names}
+
+
 def write_table(path: Path, table: pa.Table) -> None:
     """Write a Parquet table atomically."""
     sink = pa.BufferOutputStream()

@@ -61,9 +61,13 @@ class VelocityIk:
             J_task = J.T @ np.linalg.solve(J @ J.T + p.damping**2 * np.eye(3), np.eye(3))
         else:
             J_task = J_pinv
-        qdot = J_task @ v + (np.eye(robot.nq) - J_pinv @ J) @ self._repulsion(q, t)
+        limit = p.speed_scale * robot.velocity_limit
+        # The repulsion grows like 1/d³: capped at half the joint speeds on its own, so that it
+        # cannot, through the uniform scaling below, stall the task it is projected around.
+        repulsion = _limit_speed(self._repulsion(q, t), 0.5 * limit)
+        qdot = J_task @ v + (np.eye(robot.nq) - J_pinv @ J) @ repulsion
         self.iterations += 1
-        return robot.clip(q + self.dt * _limit_speed(qdot, p.speed_scale * robot.velocity_limit))
+        return robot.clip(q + self.dt * _limit_speed(qdot, limit))
 
     def _repulsion(self, q: np.ndarray, t: float) -> np.ndarray:
         p = self.params
