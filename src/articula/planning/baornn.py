@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from articula.errors import ConfigError
+from articula.planning import baornn_kernel as kernel
 from articula.planning.objective import Objective
 from articula.scene.scene import Scene
 
@@ -53,6 +54,11 @@ class Baornn:
         """One iteration of Algorithm 1 from (q, g = g(q)); returns the accepted (q, g)."""
         obj = self.objective
         b = self.rng.standard_normal(q.size)
+        if obj.compiled is not None:
+            self.evaluations += 3
+            self.iterations += 1
+            return kernel.iterations(q, g, x_ref, b[None, :], self.params.c1, self.params.c2,
+                                     *obj.kernel_arguments())  # fmt: skip
         b /= math.sqrt(b @ b)  # a normalised random direction
         lam = self.params.c1 * np.sqrt(g) if np.isfinite(g) else self.params.c1  # Eq. (1.23)
         # Eqs. (1.15)-(1.18): antennae, projected onto Ω, evaluated by "virtual robots".
@@ -69,7 +75,16 @@ class Baornn:
 
     def step(self, q: np.ndarray, x_ref: np.ndarray, t: float) -> np.ndarray:
         """One control period: re-evaluate g for the new reference, then iterate."""
-        g = self.objective.value(q, x_ref, t)
-        for _ in range(self.params.iterations_per_step):
+        obj, k = self.objective, self.params.iterations_per_step
+        g = obj.value(q, x_ref, t)
+        if obj.compiled is not None:
+            # The same draws as k calls of iterate: the Generator fills rows in order.
+            directions = self.rng.standard_normal((k, q.size))
+            self.evaluations += 3 * k
+            self.iterations += k
+            q, _ = kernel.iterations(q, g, x_ref, directions, self.params.c1, self.params.c2,
+                                     *obj.kernel_arguments())  # fmt: skip
+            return q
+        for _ in range(k):
             q, g = self.iterate(q, g, x_ref, t)
         return q

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
 
-from articula.errors import ConfigError
+from articula.errors import ConfigError, ModelError
+from articula.scene.compiled_clearance import CompiledClearance
 from articula.scene.scene import Scene
 
 
@@ -25,12 +26,26 @@ class Objective:
     lambda_weight: float
     beta: float = 1.0
     d_min: float = 0.0
+    # The compiled evaluation of the same objective, when the scene allows it (static
+    # obstacles, revolute joints, no cylinders); None: Scene (Pinocchio + coal) is used.
+    compiled: CompiledClearance | None = field(init=False, default=None, repr=False)
 
     def __post_init__(self) -> None:
         for name in ("lambda_weight", "beta", "d_min"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
                 raise ConfigError(f"planner.{name}", f"must be finite and >= 0 (got {value})")
+        object.__setattr__(self, "compiled", CompiledClearance.build(self.scene))
+
+    def kernel_arguments(self) -> tuple:
+        """Λ, β, d_min, whether distances count, joint limits and the compiled scene arrays,
+        in the order of planning.baornn_kernel (requires `compiled`)."""
+        robot, c = self.scene.robot, self.compiled
+        if c is None:
+            raise ModelError("this scene has no compiled evaluation (see Objective.compiled)")
+        return (self.lambda_weight, self.beta, self.d_min, self.needs_distance,
+                robot.model.lowerPositionLimit, robot.model.upperPositionLimit, c.arrays(),
+                c.static_min)  # fmt: skip
 
     @property
     def needs_distance(self) -> bool:
@@ -39,11 +54,17 @@ class Objective:
 
     def value(self, q: np.ndarray, x_ref: np.ndarray, t: float = 0.0) -> float:
         """Objective g at configuration q [rad] for the reference point x_ref [m]."""
+        if self.compiled is not None:
+            d, ee = self.compiled.evaluate(q)
+            return self._combine(x_ref - ee, d)
         d = self.scene.min_distance(q, t) if self.needs_distance else np.inf
         return self._value(q, x_ref, d)
 
     def tracking_error(self, q: np.ndarray, x_ref: np.ndarray) -> float:
         """The tracking term ||x_r − f(θ)|| [m] of g alone, Eq. (1.5)."""
+        if self.compiled is not None:
+            e = x_ref - self.compiled.evaluate(q)[1]
+            return math.sqrt(e @ e)
         robot = self.scene.robot
         robot.forward(q)
         e = x_ref - robot.data.oMf[robot.ee_frame_id].translation
@@ -56,6 +77,11 @@ class Objective:
         point is closer than d_min to an obstacle, stay at (q_current, g_current). One distance
         query serves both the constraint and the penalty."""
         clipped = self.scene.robot.clip(q)
+        if self.compiled is not None:
+            d, ee = self.compiled.evaluate(clipped)
+            if self.needs_distance and d < self.d_min:
+                return q_current, g_current
+            return clipped, self._combine(x_ref - ee, d)
         if not self.needs_distance:
             return clipped, self._value(clipped, x_ref, np.inf)
         d = self.scene.min_distance(clipped, t)  # also leaves the joint placements updated
@@ -72,7 +98,10 @@ class Objective:
             pin.updateFramePlacement(robot.model, robot.data, robot.ee_frame_id)
         else:
             robot.forward(q)
-        e = x_ref - robot.data.oMf[robot.ee_frame_id].translation
+        return self._combine(x_ref - robot.data.oMf[robot.ee_frame_id].translation, d)
+
+    def _combine(self, e: np.ndarray, d: float) -> float:
+        """g from the tracking error vector e [m] and the clearance d [m]."""
         g = math.sqrt(e @ e)  # Eq. (1.5); np.linalg.norm costs more than the rest for 3 numbers
         if self.lambda_weight > 0 and self.scene.obstacles:
             # Eq. (1.7): inside an obstacle the penalty has no finite value.

@@ -1,0 +1,70 @@
+"""Algorithm 1's inner loop compiled: iterations of BAORNN on a CompiledClearance.
+
+The same steps as `Baornn.iterate` (Eqs. 1.15-1.24), with the objective (1.13) and the
+projection (1.17) evaluated by `_evaluate`, so one control period is one call from Python.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from articula.scene.compiled_clearance import _evaluate
+
+
+@njit(cache=True)
+def _project_and_value(
+    q, q_current, g_current, x_ref, lambda_weight, beta, d_min, use_distance, lower, upper,
+    arrays, static_min,
+):  # fmt: skip
+    """(P_Ω(q), g there), Eqs. (1.17)-(1.18); stays at (q_current, g_current) if the clipped
+    point is closer than d_min to an obstacle (1.12)."""
+    clipped = np.minimum(np.maximum(q, lower), upper)
+    d, ee = _evaluate(clipped, *arrays, static_min)
+    if use_distance and d < d_min:
+        return q_current, g_current
+    ex, ey, ez = x_ref[0] - ee[0], x_ref[1] - ee[1], x_ref[2] - ee[2]
+    g = math.sqrt(ex * ex + ey * ey + ez * ez)  # Eq. (1.5)
+    if lambda_weight > 0.0 and use_distance:
+        g += lambda_weight / d**beta if d > 0.0 else np.inf  # Eq. (1.7)
+    return clipped, g
+
+
+@njit(cache=True)
+def value(q, x_ref, lambda_weight, beta, use_distance, arrays, static_min):
+    """g(q) of Eq. (1.13) for the reference point x_ref [m] (no projection)."""
+    d, ee = _evaluate(q, *arrays, static_min)
+    ex, ey, ez = x_ref[0] - ee[0], x_ref[1] - ee[1], x_ref[2] - ee[2]
+    g = math.sqrt(ex * ex + ey * ey + ez * ez)
+    if lambda_weight > 0.0 and use_distance:
+        g += lambda_weight / d**beta if d > 0.0 else np.inf
+    return g
+
+
+@njit(cache=True)
+def iterations(
+    q, g, x_ref, directions, c1, c2, lambda_weight, beta, d_min, use_distance, lower, upper,
+    arrays, static_min,
+):  # fmt: skip
+    """Run one iteration of Algorithm 1 per row of `directions` (raw Gaussian draws, normalised
+    here); returns the accepted (q, g)."""
+    for k in range(directions.shape[0]):
+        b = directions[k] / math.sqrt(directions[k] @ directions[k])
+        lam = c1 * math.sqrt(g) if math.isfinite(g) else c1  # Eq. (1.23)
+        _, g_left = _project_and_value(q + lam * b, q, g, x_ref, lambda_weight, beta,
+                                            d_min, use_distance, lower, upper, arrays,
+                                            static_min)  # fmt: skip
+        _, g_right = _project_and_value(q - lam * b, q, g, x_ref, lambda_weight, beta,
+                                              d_min, use_distance, lower, upper, arrays,
+                                              static_min)  # fmt: skip
+        diff = g_left - g_right
+        sign = 1.0 if diff > 0.0 else (-1.0 if diff < 0.0 else 0.0)  # 0 when both are inf
+        step = q - c2 * lam * sign * b  # Eqs. (1.19), (1.24)
+        q_new, g_new = _project_and_value(step, q, g, x_ref, lambda_weight, beta, d_min,
+                                          use_distance, lower, upper, arrays,
+                                          static_min)  # fmt: skip
+        if g_new < g:  # Eqs. (1.21)-(1.22)
+            q, g = q_new, g_new
+    return q, g

@@ -1,0 +1,291 @@
+"""The planner's hot path in one compiled call: forward kinematics, the end-effector position
+and the smallest link-obstacle clearance, with the same capsule broad phase as Scene.
+
+One BAORNN iteration evaluates the objective three times; through Pinocchio and coal each
+evaluation is a dozen Python-level calls into C++ (about 1 µs each, see docs/architecture.md).
+Here the whole evaluation is one numba function over arrays taken from the same Scene. It
+covers the common case (revolute joints; polytope, sphere and capsule shapes; obstacles that
+do not move) and `CompiledClearance.build` returns None otherwise, so callers fall back to
+Scene.min_distance. Clearance is GJK distance, and 0 when shapes overlap (no depth).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+from numba import njit
+from scipy.spatial import ConvexHull
+
+from articula.geometry.shapes import ConvexShape
+from articula.scene.gjk import gjk_distance
+from articula.scene.scene import Scene
+
+_AXES = {"JointModelRX": (1.0, 0.0, 0.0), "JointModelRY": (0.0, 1.0, 0.0),
+         "JointModelRZ": (0.0, 0.0, 1.0)}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class CompiledClearance:
+    """Arrays of a Scene for `evaluate`: kinematic chain, shape cores, capsules and pairs."""
+
+    parents: np.ndarray  # (joints,) parent joint index; joint 0 is the world
+    joint_rot: np.ndarray  # (joints, 3, 3) joint placement in the parent joint frame
+    joint_p: np.ndarray  # (joints, 3)
+    axes: np.ndarray  # (joints, 3) revolute axis in the joint frame
+    q_index: np.ndarray  # (joints,) index of the joint's angle in q
+    ee_joint: int
+    ee_p: np.ndarray  # end-effector origin in its joint frame
+    vertices: np.ndarray  # (total, 3) cores of every shape in their own frame, concatenated
+    starts: np.ndarray  # (shapes + 1,) offsets into vertices
+    neighbours: np.ndarray  # vertices joined by a hull edge, CSR by vertex (global indices)
+    offsets: np.ndarray  # (total + 1,)
+    hints: np.ndarray  # (shapes,) where each support search starts (mutable scratch)
+    guesses: np.ndarray  # (pairs, 3) last closest point of each pair's A − B (mutable scratch)
+    radii: np.ndarray  # (shapes,)
+    shape_joint: np.ndarray  # (shapes,) joint a shape moves with (0: the world)
+    shape_rot: np.ndarray  # (shapes, 3, 3) shape pose in its joint frame (world for obstacles)
+    shape_p: np.ndarray  # (shapes, 3)
+    capsule_a: np.ndarray  # (shapes, 3) ends of each bounding capsule, in the shape's frame
+    capsule_b: np.ndarray
+    capsule_r: np.ndarray
+    pairs: np.ndarray  # (pairs, 3) (link shape, obstacle shape, guess row) that can move
+    static_min: float  # smallest distance of the pairs that never move
+
+    @classmethod
+    def build(cls, scene: Scene) -> CompiledClearance | None:
+        """The arrays of `scene`, or None when it needs something this path does not cover."""
+        model = scene.robot.model
+        names = [model.joints[j].shortname() for j in range(1, model.njoints)]
+        if any(o.moving for o in scene.obstacles):
+            return None
+        if any(name not in _AXES and name != "JointModelRevoluteUnaligned" for name in names):
+            return None
+        shapes, joints, poses = [], [], []
+        # Without obstacles only the kinematics are needed: no shape at all.
+        for link in scene.robot.links if scene.obstacles else ():
+            frame = model.frames[link.frame_id]
+            for shape, T in zip(link.shapes, link.placements, strict=True):
+                shapes.append(shape)
+                joints.append(frame.parentJoint)
+                poses.append((frame.placement * pin.SE3(T)).homogeneous)
+        n_links = len(shapes)
+        for obstacle in scene.obstacles:
+            for part in obstacle.parts:
+                shapes.append(part)
+                joints.append(0)
+                poses.append(obstacle.pose_at(0.0))
+        cores = [_core(s) for s in shapes]
+        if any(c is None for c in cores):
+            return None
+        starts = np.cumsum([0] + [len(c[0]) for c in cores]).astype(np.int64)
+        neighbours, offsets = _edges([c[0] for c in cores], starts)
+        axes = np.zeros((model.njoints, 3))
+        for j in range(1, model.njoints):
+            joint = model.joints[j]
+            name = joint.shortname()
+            axes[j] = _AXES[name] if name in _AXES else joint.extract().axis
+        bounds = [_capsule_ends(s) for s in shapes]
+        pairs = [(a, b) for a in range(n_links) for b in range(n_links, len(shapes))]
+        moving = [(a, b) for a, b in pairs if joints[a] != 0]
+        index = {pair: k for k, pair in enumerate(pairs)}
+        fixed = [(a, b) for a, b in pairs if joints[a] == 0]
+        placements = model.jointPlacements
+        out = cls(
+            parents=np.array(model.parents, dtype=np.int64),
+            joint_rot=np.array([placements[j].rotation for j in range(model.njoints)]),
+            joint_p=np.array([placements[j].translation for j in range(model.njoints)]),
+            axes=axes,
+            q_index=np.array(model.idx_qs, dtype=np.int64),
+            ee_joint=int(model.frames[scene.robot.ee_frame_id].parentJoint),
+            ee_p=np.array(model.frames[scene.robot.ee_frame_id].placement.translation),
+            vertices=np.concatenate([c[0] for c in cores] or [np.zeros((0, 3))]),
+            starts=starts,
+            neighbours=neighbours,
+            offsets=offsets,
+            hints=starts[:-1].copy(),
+            guesses=np.zeros((len(pairs), 3)),
+            radii=np.array([c[1] for c in cores], dtype=float),
+            shape_joint=np.array(joints, dtype=np.int64),
+            shape_rot=np.array([T[:3, :3] for T in poses]).reshape(-1, 3, 3),
+            shape_p=np.array([T[:3, 3] for T in poses]).reshape(-1, 3),
+            capsule_a=np.array([b[0] for b in bounds]).reshape(-1, 3),
+            capsule_b=np.array([b[1] for b in bounds]).reshape(-1, 3),
+            capsule_r=np.array([b[2] for b in bounds], dtype=float),
+            pairs=np.array([(a, b, index[a, b]) for a, b in moving], dtype=np.int64).reshape(-1, 3),
+            static_min=np.inf,
+        )
+        if fixed:
+            q0 = np.zeros(model.nq)
+            fixed_pairs = np.array([(a, b, index[a, b]) for a, b in fixed], dtype=np.int64)
+            static = _evaluate(q0, *out.arrays(fixed_pairs), np.inf)[0]
+            object.__setattr__(out, "static_min", static)
+        return out
+
+    def evaluate(self, q: np.ndarray) -> tuple[float, np.ndarray]:
+        """(clearance [m], end-effector position [m]) at q [rad]; clearance 0 on overlap and
+        +inf without obstacles."""
+        return _evaluate(q, *self.arrays(), self.static_min)
+
+    def arrays(self, pairs: np.ndarray | None = None) -> tuple:
+        """The arguments of the compiled evaluation after q (all but static_min)."""
+        pairs = self.pairs if pairs is None else pairs
+        return (self.parents, self.joint_rot, self.joint_p, self.axes, self.q_index,
+                self.ee_joint, self.ee_p, self.vertices, self.starts, self.neighbours,
+                self.offsets, self.hints, self.guesses, self.radii,
+                self.shape_joint, self.shape_rot, self.shape_p, self.capsule_a, self.capsule_b,
+                self.capsule_r, pairs)  # fmt: skip
+
+
+def _core(shape: ConvexShape) -> tuple[np.ndarray, float] | None:
+    """(core vertices, radius) of a shape, or None for a shape GJK here cannot represent."""
+    if shape.kind in ("convex", "box"):
+        return np.asarray(shape.vertices, dtype=float), 0.0
+    if shape.kind == "sphere":
+        return np.zeros((1, 3)), float(shape.geometry.radius)
+    if shape.kind == "capsule":
+        half = float(shape.geometry.halfLength)
+        return np.array([[0.0, 0.0, -half], [0.0, 0.0, half]]), float(shape.geometry.radius)
+    return None  # cylinders: round rims are not a swept polytope
+
+
+def _edges(cores: list[np.ndarray], starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Hull-edge adjacency of every core as CSR arrays over the concatenated vertices; cores of
+    one or two points (spheres, capsules) are joined completely."""
+    lists: list[set[int]] = []
+    for core, first in zip(cores, starts, strict=False):
+        local = [set() for _ in range(len(core))]
+        if len(core) >= 4:
+            for tri in ConvexHull(core).simplices:
+                for i in range(3):
+                    a, b = int(tri[i]), int(tri[(i + 1) % 3])
+                    local[a].add(b)
+                    local[b].add(a)
+        else:
+            local = [set(range(len(core))) - {i} for i in range(len(core))]
+        lists += [{int(first) + m for m in nbrs} for nbrs in local]
+    offsets = np.cumsum([0] + [len(n) for n in lists]).astype(np.int64)
+    flat = [m for nbrs in lists for m in sorted(nbrs)]
+    return np.array(flat, dtype=np.int64), offsets
+
+
+def _capsule_ends(shape: ConvexShape) -> tuple[np.ndarray, np.ndarray, float]:
+    """The bounding capsule as its two segment ends (shape frame) and radius."""
+    T, half = shape.bound.pose, shape.bound.length / 2
+    return T[:3, 3] - half * T[:3, 2], T[:3, 3] + half * T[:3, 2], shape.bound.radius
+
+
+@njit(cache=True)
+def _compose(
+    R1: np.ndarray, p1: np.ndarray, R2: np.ndarray, p2: np.ndarray, R: np.ndarray, p: np.ndarray
+) -> None:
+    """(R, p) = (R1, p1) ∘ (R2, p2): R = R1 R2, p = p1 + R1 p2 (3×3 by hand: no BLAS call)."""
+    for i in range(3):
+        p[i] = p1[i] + R1[i, 0] * p2[0] + R1[i, 1] * p2[1] + R1[i, 2] * p2[2]
+        for k in range(3):
+            R[i, k] = R1[i, 0] * R2[0, k] + R1[i, 1] * R2[1, k] + R1[i, 2] * R2[2, k]
+
+
+@njit(cache=True)
+def _rotate_about(R: np.ndarray, axis: np.ndarray, angle: float, out: np.ndarray) -> None:
+    """out = R · Rot(axis, angle) (Rodrigues), axis a unit vector."""
+    c, s = np.cos(angle), np.sin(angle)
+    x, y, z = axis[0], axis[1], axis[2]
+    C = 1.0 - c
+    r00, r01, r02 = c + x * x * C, x * y * C - z * s, x * z * C + y * s
+    r10, r11, r12 = y * x * C + z * s, c + y * y * C, y * z * C - x * s
+    r20, r21, r22 = z * x * C - y * s, z * y * C + x * s, c + z * z * C
+    for i in range(3):
+        a, b, d = R[i, 0], R[i, 1], R[i, 2]
+        out[i, 0] = a * r00 + b * r10 + d * r20
+        out[i, 1] = a * r01 + b * r11 + d * r21
+        out[i, 2] = a * r02 + b * r12 + d * r22
+
+
+@njit(cache=True)
+def _apply(R: np.ndarray, p: np.ndarray, x: np.ndarray, out: np.ndarray) -> None:
+    """out = R x + p."""
+    for i in range(3):
+        out[i] = R[i, 0] * x[0] + R[i, 1] * x[1] + R[i, 2] * x[2] + p[i]
+
+
+@njit(cache=True)
+def _segment_distance(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> float:
+    """Distance between segments [p1, q1] and [p2, q2] (Ericson, Sect. 5.1.9), in scalars."""
+    d1x, d1y, d1z = q1[0] - p1[0], q1[1] - p1[1], q1[2] - p1[2]
+    d2x, d2y, d2z = q2[0] - p2[0], q2[1] - p2[1], q2[2] - p2[2]
+    rx, ry, rz = p1[0] - p2[0], p1[1] - p2[1], p1[2] - p2[2]
+    a = d1x * d1x + d1y * d1y + d1z * d1z
+    e = d2x * d2x + d2y * d2y + d2z * d2z
+    f = d2x * rx + d2y * ry + d2z * rz
+    s = 0.0
+    t = 0.0
+    if a > 1e-18 or e > 1e-18:
+        if a <= 1e-18:
+            t = min(max(f / e, 0.0), 1.0)
+        else:
+            c = d1x * rx + d1y * ry + d1z * rz
+            if e <= 1e-18:
+                s = min(max(-c / a, 0.0), 1.0)
+            else:
+                b = d1x * d2x + d1y * d2y + d1z * d2z
+                denom = a * e - b * b
+                s = min(max((b * f - c * e) / denom, 0.0), 1.0) if denom > 0.0 else 0.0
+                t = (b * s + f) / e
+                if t < 0.0:
+                    t, s = 0.0, min(max(-c / a, 0.0), 1.0)
+                elif t > 1.0:
+                    t, s = 1.0, min(max((b - c) / a, 0.0), 1.0)
+    gx = rx + d1x * s - d2x * t
+    gy = ry + d1y * s - d2y * t
+    gz = rz + d1z * s - d2z * t
+    return np.sqrt(gx * gx + gy * gy + gz * gz)
+
+
+@njit(cache=True)
+def _evaluate(
+    q, parents, joint_rot, joint_p, axes, q_index, ee_joint, ee_p, vertices, starts,
+    neighbours, offsets, hints, guesses, radii, shape_joint, shape_rot, shape_p, capsule_a,
+    capsule_b, capsule_r, pairs, static_min,
+):  # fmt: skip
+    """Forward kinematics, shape poses, capsule lower bounds, then exact GJK in order of bound
+    until no bound is below the best distance found (the broad phase of Scene)."""
+    nj = parents.size
+    oR = np.empty((nj, 3, 3))
+    op = np.empty((nj, 3))
+    oR[0] = np.eye(3)
+    op[0] = 0.0
+    placed = np.empty((3, 3))
+    for j in range(1, nj):
+        parent = parents[j]
+        _compose(oR[parent], op[parent], joint_rot[j], joint_p[j], placed, op[j])
+        _rotate_about(placed, axes[j], q[q_index[j]], oR[j])
+    ee = np.empty(3)
+    _apply(oR[ee_joint], op[ee_joint], ee_p, ee)
+    ns = radii.size
+    world_R = np.empty((ns, 3, 3))
+    world_p = np.empty((ns, 3))
+    ends = np.empty((ns, 2, 3))
+    for s in range(ns):
+        j = shape_joint[s]
+        _compose(oR[j], op[j], shape_rot[s], shape_p[s], world_R[s], world_p[s])
+        _apply(world_R[s], world_p[s], capsule_a[s], ends[s, 0])
+        _apply(world_R[s], world_p[s], capsule_b[s], ends[s, 1])
+    npairs = pairs.shape[0]
+    lower = np.empty(npairs)
+    for k in range(npairs):
+        a, b = pairs[k, 0], pairs[k, 1]
+        gap = _segment_distance(ends[a, 0], ends[a, 1], ends[b, 0], ends[b, 1])
+        lower[k] = gap - capsule_r[a] - capsule_r[b]
+    best = static_min
+    for k in np.argsort(lower):
+        if lower[k] >= best:
+            break
+        a, b = pairs[k, 0], pairs[k, 1]
+        d = gjk_distance(vertices, neighbours, offsets, hints,
+                         a, world_R[a], world_p[a], radii[a],
+                         b, world_R[b], world_p[b], radii[b], guesses[pairs[k, 2]])  # fmt: skip
+        if d < best:
+            best = d
+    return best, ee
