@@ -110,7 +110,7 @@ def sweep(
 @app.command()
 def reproduce(
     chapter: Annotated[
-        str, typer.Argument(help="ch4 or all (chapters 1-3 are not yet built).")
+        str, typer.Argument(help="A chapter (ch3, ch4, ...) or all; unbuilt chapters are refused.")
     ] = "all",
     out_dir: OutDir = Path("report"),
     full: Annotated[bool, typer.Option("--full", help="Full-size runs instead of quick.")] = False,

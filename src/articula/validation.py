@@ -26,6 +26,14 @@ class StrictModel(BaseModel):
             raise config_error_from(exc, type(self).__name__) from None
 
 
+def field_error(name: str, problem: str) -> ConfigError:
+    """A ConfigError for a check across fields, raised inside a validator, that names `name`
+    (validation prefixes the path of the table it sits in)."""
+    error = ConfigError(name, problem)
+    error.loc = (name,)
+    return error
+
+
 def parse_model(model: type[M], data: Mapping[str, Any], where: str = "") -> M:
     """Validate `data` into `model`, raising ConfigError naming the first bad field."""
     try:

@@ -23,7 +23,7 @@ from articula.planning.trajectories import Circle, Waypoints, rectangle
 from articula.planning.velocity_ik import VelocityIk, VelocityIkParams
 from articula.scene.config import build_scene, load_scene_spec
 from articula.scene.scene import Scene
-from articula.validation import StrictModel, load_toml, parse_model
+from articula.validation import StrictModel, field_error, load_toml, parse_model
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
@@ -92,10 +92,17 @@ class PlannerSpec(StrictModel):
     @model_validator(mode="after")
     def _times(self) -> PlannerSpec:
         if self.settle >= self.duration:
-            raise ValueError("settle must be shorter than duration")
+            raise field_error("settle", f"must be shorter than duration = {self.duration} s")
         if self.safety >= self.influence:
-            raise ValueError("safety must be smaller than influence")
+            raise field_error("safety", f"must be smaller than influence = {self.influence} m")
         return self
+
+
+class PlanTables(StrictModel):
+    """The [trajectory] and [planner] tables of a scene file."""
+
+    trajectory: TrajectorySpec
+    planner: PlannerSpec = PlannerSpec()
 
 
 def make_planner(spec: PlannerSpec, scene: Scene) -> Planner:
@@ -144,8 +151,9 @@ def plan_data(
         )
     if "trajectory" not in data:
         raise ConfigError(f"{where}: trajectory", "the [trajectory] table is missing")
-    trajectory_spec = parse_model(TrajectorySpec, data["trajectory"], f"{where}: trajectory")
-    planner_spec = parse_model(PlannerSpec, data.get("planner", {}), f"{where}: planner")
+    tables = parse_model(PlanTables, {k: data[k] for k in ("trajectory", "planner") if k in data},
+                         where)  # fmt: skip
+    trajectory_spec, planner_spec = tables.trajectory, tables.planner
     scene, q0 = build_scene(load_scene_spec(data, where), base_dir)
     trajectory = make_trajectory(trajectory_spec, base_dir)
     p = planner_spec
@@ -164,8 +172,8 @@ def plan_data(
     metrics = _metrics(result, scene.robot, p.settle, wall, planner.iterations)
     if metrics["rms_error"] > p.tolerance:
         raise InfeasibleError(
-            f"trajectory: not tracked: rms error {metrics['rms_error']:.4f} m after "
-            f"{p.settle} s (max {metrics['max_error']:.4f} m) exceeds planner.tolerance = "
+            f"trajectory: not tracked: rms error {metrics['rms_error']:.3g} m after "
+            f"{p.settle} s (max {metrics['max_error']:.3g} m) exceeds planner.tolerance = "
             f"{p.tolerance} m; the path may be out of reach or blocked"
         )
     return config, Result(metrics, _trace(result)), wall

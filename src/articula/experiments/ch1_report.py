@@ -240,13 +240,15 @@ def _claims(
 
 
 def _scene_lines(scenes: Mapping[str, Scene]) -> list[str]:
+    p = load_toml(packaged(SCENES["rectangle"]))["planner"]
     lines = [
         "The book gives no obstacle shapes or poses; ours (docs/deviations.md) put the obstacles "
         "in the way of the links, not of the end effector, so that only the arm's redundancy "
-        "can avoid them. Every run starts at q = 0 (the home position), control period 10 ms, "
-        "10 BAORNN iterations per period, c1 = 0.3, c2 = 0.5, β = 1; errors are taken after a "
-        "5 s settling time. Λ = 0 runs also drop the d_min constraint, as the book does "
-        "(Sect. 1.4.1). Reproduce one run with `articula plan "
+        f"can avoid them. Every run starts at q = 0 (the home position), control period "
+        f"{1e3 * p['dt']:g} ms, {p['iterations_per_step']} BAORNN iterations per period, "
+        f"c1 = {p['c1']}, c2 = {p['c2']}, β = {p['beta']}; errors are taken after a "
+        f"{p['settle']:g} s settling time. Λ = 0 runs also drop the d_min constraint, as the "
+        "book does (Sect. 1.4.1). Reproduce one run with `articula plan "
         "src/articula/experiments/configs/ch1/<scene>.toml --out DIR` (edit `[planner]`).",
         "",
         "| scene | file | obstacles (mesh at position [m]) |",

@@ -70,4 +70,4 @@ def config_to_dict(exp: Experiment, config: BaseModel) -> dict[str, Any]:
 
 def _load_builtin() -> None:
     """Import the chapter modules so that their experiments register themselves."""
-    from articula.experiments import ch4  # noqa: F401
+    from articula.experiments import ch2, ch3, ch4  # noqa: F401

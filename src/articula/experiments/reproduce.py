@@ -18,9 +18,17 @@ Section = Callable[[Path, bool, int, Progress], tuple[str, dict[str, Any]]]
 
 def _sections() -> dict[str, tuple[str, Section]]:
     """Chapters that can be reproduced today, in report order."""
+    from articula.experiments.ch1_report import ch1_section
+    from articula.experiments.ch2_report import ch2_section
+    from articula.experiments.ch3_report import ch3_section
     from articula.experiments.ch4_report import ch4_section
 
-    return {"ch4": ("Chapter 4: DC motor torque (current) control", ch4_section)}
+    return {
+        "ch1": ("Chapter 1: obstacle avoidance of a redundant arm (BAORNN)", ch1_section),
+        "ch2": ("Chapter 2: PID control of a soft bending actuator (PneuNet)", ch2_section),
+        "ch3": ("Chapter 3: six-chamber soft actuator and active oscillation damping", ch3_section),
+        "ch4": ("Chapter 4: DC motor torque (current) control", ch4_section),
+    }
 
 
 def check_chapter(chapter: str) -> None:

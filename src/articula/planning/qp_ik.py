@@ -39,6 +39,8 @@ class QpIkParams:
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
                 raise ConfigError(f"planner.{name}", f"must be finite and >= 0 (got {value})")
+        if self.speed_scale <= 0:
+            raise ConfigError("planner.speed_scale", "must be > 0 (a fraction of the URDF limits)")
         if self.safety >= self.influence or self.limit_safety >= self.limit_influence:
             raise ConfigError("planner.safety", "must be smaller than its influence distance")
 
@@ -76,6 +78,8 @@ class QpIk:
         if self.scene.obstacles:
             rows = clearance_rows(self.scene, q, t, p.influence)
             for d, grad in zip(rows.distance, rows.gradient, strict=True):
+                if not np.any(grad):
+                    continue  # a world-fixed link: no joint changes d, so no row can help
                 # −∇d·q̇ ≤ ξ (d − d_s)/(d_i − d_s): approach no faster than the damper allows.
                 G_rows.append(np.r_[-grad, np.zeros(3)])
                 h_rows.append(p.damper_gain * (d - p.safety) / (p.influence - p.safety))

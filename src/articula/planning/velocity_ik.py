@@ -13,6 +13,8 @@ from articula.planning.clearance import clearance_rows
 from articula.planning.reference_velocity import reference_velocity
 from articula.scene.scene import Scene
 
+PINV_CUTOFF = 1e-6
+
 
 @dataclass(frozen=True)
 class VelocityIkParams:
@@ -35,6 +37,8 @@ class VelocityIkParams:
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
                 raise ConfigError(f"planner.{name}", f"must be finite and >= 0 (got {value})")
+        if self.speed_scale <= 0:
+            raise ConfigError("planner.speed_scale", "must be > 0 (a fraction of the URDF limits)")
 
 
 @dataclass
@@ -56,7 +60,9 @@ class VelocityIk:
         v = reference_velocity(x_ref, self._previous_ref, x, self.dt, p.gain)
         self._previous_ref = x_ref.copy()
         J = robot.jacobian(q)[:3]
-        J_pinv = np.linalg.pinv(J)
+        # Singular values below 1e-6 of the largest are round-off (the stretched home pose has
+        # 1e-13): inverting them would let the last bits of q choose the direction of motion.
+        J_pinv = np.linalg.pinv(J, rcond=PINV_CUTOFF)
         if self.method == "dls":
             J_task = J.T @ np.linalg.solve(J @ J.T + p.damping**2 * np.eye(3), np.eye(3))
         else:

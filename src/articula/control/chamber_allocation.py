@@ -1,0 +1,32 @@
+"""Chamber pressures that bend the six-chamber actuator away from any side (Sect. 3.2.2)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from articula.plants.six_chamber import CHAMBERS
+
+
+def side_pressures(side_deg: float, gauge: float) -> np.ndarray:
+    """Gauge pressures [Pa] of the six chambers that push as one chamber of `gauge` at `side_deg`.
+
+    side_deg [deg] is the side that is pressurised (chamber i sits at 60°·i); the body bends
+    toward side_deg + 180°. Between two chambers the force vector gauge·ê_side is split over
+    the two nearest chambers (p_a ê_a + p_b ê_b = gauge·ê_side, both ≥ 0, neither above gauge).
+    """
+    side = float(side_deg) % 360.0
+    lower = int(side // 60.0) % CHAMBERS
+    alpha = math.radians(side - 60.0 * (side // 60.0))
+    sixty = math.radians(60.0)
+    pressures = np.zeros(CHAMBERS)
+    pressures[lower] += gauge * math.sin(sixty - alpha) / math.sin(sixty)
+    pressures[(lower + 1) % CHAMBERS] += gauge * math.sin(alpha) / math.sin(sixty)
+    return pressures
+
+
+def bend_direction(side_deg: float) -> np.ndarray:
+    """Unit vector (2,) toward which the top tilts when `side_deg` is pressurised."""
+    away = math.radians(side_deg + 180.0)
+    return np.array([math.cos(away), math.sin(away)])

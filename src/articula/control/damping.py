@@ -1,0 +1,57 @@
+"""Active oscillation damping of chapter 3: pulse the chambers opposite the ones deactuated."""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated
+
+import numpy as np
+from pydantic import Field
+
+from articula.plants.six_chamber import CHAMBERS, SixChamberParams
+from articula.plants.six_chamber_sim import FILL, HOLD, VENT, fill_time
+from articula.validation import StrictModel
+
+NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+
+
+class DampingPolicy(StrictModel):
+    """On deactuating a side, pulse the opposite side to δ times its pressure (Eq. 3.4).
+
+    delta: damping actuation ratio δ (0 = no damping). start [s]: delay of the opposite fill
+    after the deactuation command (0 = simultaneous, as in Sect. 3.2.4). length [s]: time from
+    opening the fill valve to venting; the valve fills for the open time that reaches δ·P, holds
+    for the rest, and vents no earlier than filled (0 = vent as soon as filled, the brief pulse).
+    """
+
+    delta: Annotated[float, Field(ge=0, le=0.95, allow_inf_nan=False)] = 0.0
+    start: NonNegative = 0.0
+    length: NonNegative = 0.0
+
+    def events(
+        self, p: SixChamberParams, pressures: np.ndarray, t_off: float
+    ) -> list[tuple[float, int, int]]:
+        """Valve events (time [s], chamber, mode) of the pulse for a deactuation at t_off [s].
+
+        `pressures` [Pa] are the deactuated chambers' gauge pressures; chamber i's pulse goes
+        to chamber i + 3 at δ·pressures[i], filled by the valve open time that reaches it.
+        """
+        events: list[tuple[float, int, int]] = []
+        if self.delta == 0:
+            return events
+        for i in range(CHAMBERS):
+            if pressures[i] <= 0:
+                continue
+            opposite = (i + CHAMBERS // 2) % CHAMBERS
+            t_fill = t_off + self.start
+            t_open = fill_time(p, self.delta * pressures[i])  # δ of Eq. (3.4) via open time
+            t_vent = t_fill + max(self.length, 0.0 if math.isinf(t_open) else t_open)
+            events.append((t_fill, opposite, FILL))
+            if math.isfinite(t_open):
+                events.append((t_fill + t_open, opposite, HOLD))
+            events.append((t_vent, opposite, VENT))  # after HOLD when hold = 0
+        return events
+
+    def pulse_length(self, p: SixChamberParams, pressure: float) -> float:
+        """Time [s] the opposite chamber is not venting: `length`, or its fill time if longer."""
+        return max(self.length, fill_time(p, self.delta * pressure))

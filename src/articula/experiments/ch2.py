@@ -1,0 +1,249 @@
+"""Chapter 2 experiment: a PID of the family (2.2)-(2.4) on the simulated PneuNet, many trials.
+
+The controller works in degrees because the book's gains are per degree; its output is the
+8-bit PWM value (0-255) the Arduino writes, so K_p is in counts/°, K_i in counts/(°·s) and
+K_d in counts·s/°. Everything else is SI inside and degrees at the interface.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Annotated, Literal
+
+import numpy as np
+from pydantic import Field, model_validator
+
+from articula.control.pid import PID, GainSchedule
+from articula.experiments.registry import Result, register
+from articula.plants.pneunet import PneuNetBatch, PneuNetParams
+from articula.tuning.response import Response, tracking_error, tuning_cost
+from articula.validation import StrictModel
+
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+Angle = Annotated[float, Field(ge=0, le=90, allow_inf_nan=False)]  # [°], the book's range
+GainRow = Annotated[list[NonNegative], Field(min_length=3, max_length=3)]
+MAX_STEPS = 1_000_000
+MAX_TRIALS = 10_000
+MAX_SAMPLES = 20_000_000  # trials × steps: three float64 channels of this size are ~0.5 GB
+
+
+class ReferenceConfig(StrictModel):
+    """θ_r(t) in degrees: a sinusoid from rest, or steps held for equal times."""
+
+    kind: Literal["sinusoid", "steps"] = "sinusoid"
+    offset_deg: Angle = 45.0  # sinusoid: θ_r = offset − amplitude·cos(2πft), starts at rest
+    amplitude_deg: Angle = 45.0
+    frequency: NonNegative = 0.05  # [Hz]
+    levels_deg: Annotated[list[Angle], Field(min_length=1)] = Field(  # steps, in order
+        default_factory=lambda: [90.0]
+    )
+
+    @model_validator(mode="after")
+    def _inside_range(self) -> ReferenceConfig:
+        lo, hi = self.offset_deg - self.amplitude_deg, self.offset_deg + self.amplitude_deg
+        if self.kind == "sinusoid" and (lo < 0 or hi > 90):
+            raise ValueError(
+                f"the sinusoid spans {lo:g}-{hi:g}°, outside the book's 0-90°; "
+                "lower amplitude_deg or move offset_deg"
+            )
+        return self
+
+
+class ControllerConfig(StrictModel):
+    """Gain schedule of Eq. (2.4), PWM output range and optional derivative filter."""
+
+    name: str = "ordinary"  # a label, e.g. "fuzzy-auto"; reported, not interpreted
+    schedule: Literal["constant", "piecewise", "fuzzy"] = "constant"
+    gains: Annotated[list[GainRow], Field(min_length=1)] = Field(  # rows [K_p, K_i, K_d]
+        default_factory=lambda: [[1.0, 1.0, 0.0]]
+    )
+    points_deg: list[Angle] = Field(  # representative points (Sect. 2.4.2.1)
+        default_factory=lambda: [15.0, 45.0, 75.0]
+    )
+    pwm_bits: Annotated[int, Field(ge=1, le=16)] = 8  # analogWrite: 0-255
+    derivative_tau: NonNegative = 0.0  # [s]; 0: unfiltered, as in the book
+
+    @model_validator(mode="after")
+    def _rows_match(self) -> ControllerConfig:
+        rows = len(self.gains)
+        if self.schedule == "constant" and rows != 1:
+            raise ValueError(f"a constant schedule takes one row of gains (got {rows})")
+        if self.schedule != "constant" and rows != len(self.points_deg):
+            raise ValueError(
+                f"{self.schedule} needs one row of gains per point of points_deg "
+                f"({len(self.points_deg)}), got {rows}"
+            )
+        if self.schedule != "constant" and any(
+            b <= a for a, b in zip(self.points_deg, self.points_deg[1:], strict=False)
+        ):
+            raise ValueError(f"points_deg must increase (got {self.points_deg})")
+        return self
+
+    def build(self, trials: int) -> PID:
+        """The PID this config describes, for `trials` parallel actuators."""
+        schedule = GainSchedule(self.schedule, np.array(self.gains), np.array(self.points_deg))
+        return PID(schedule, (0.0, 2.0**self.pwm_bits - 1), self.derivative_tau, trials)
+
+
+class PneuNetPidConfig(StrictModel):
+    """`trials` runs of one controller on the PneuNet, each with its own noise seed."""
+
+    seed: Annotated[int, Field(ge=0)] = 0  # trial i draws its noise from seed + i
+    trials: Annotated[int, Field(ge=1, le=MAX_TRIALS)] = 25
+    duration: Positive = 40.0  # [s]
+    settle: NonNegative = 0.0  # [s] before E is taken (0: every sample, as Eq. 2.7)
+    reference: ReferenceConfig = ReferenceConfig()
+    controller: ControllerConfig = ControllerConfig()
+    plant: PneuNetParams = PneuNetParams()
+
+    @model_validator(mode="after")
+    def _check_times(self) -> PneuNetPidConfig:
+        steps = self.duration / self.plant.pwm_period
+        if steps > MAX_STEPS:
+            raise ValueError(f"duration/pwm_period is over {MAX_STEPS} steps; shorten duration")
+        if steps * self.trials > MAX_SAMPLES:
+            raise ValueError(
+                f"trials × steps is over {MAX_SAMPLES}; run fewer trials per config (a sweep "
+                "over seed splits them)"
+            )
+        if self.settle >= self.duration - 2 * self.plant.pwm_period:
+            raise ValueError(
+                f"settle ({self.settle} s) leaves fewer than two samples of duration "
+                f"({self.duration} s); shorten settle"
+            )
+        if self.duration < len(self.reference.levels_deg) * self.plant.pwm_period:
+            raise ValueError("duration is shorter than one sample per level of the reference")
+        return self
+
+    @property
+    def steps(self) -> int:
+        """Control periods simulated (one PWM period each)."""
+        return round(self.duration / self.plant.pwm_period)
+
+
+@dataclass(frozen=True)
+class ClosedLoopTrace:
+    """Times [s] (n,), reference [°] (n,); measured, true angle [°] and duty, (trials, n)."""
+
+    t: np.ndarray
+    reference: np.ndarray
+    measured: np.ndarray
+    theta: np.ndarray
+    duty: np.ndarray
+
+
+def reference_deg(reference: ReferenceConfig, t: np.ndarray) -> np.ndarray:
+    """θ_r at the sample times [°]."""
+    if reference.kind == "sinusoid":
+        phase = 2 * math.pi * reference.frequency * t
+        return reference.offset_deg - reference.amplitude_deg * np.cos(phase)
+    levels = np.asarray(reference.levels_deg, dtype=float)
+    index = np.minimum((np.arange(t.size) * levels.size) // t.size, levels.size - 1)
+    return levels[index]
+
+
+def run_closed_loop(
+    params: PneuNetParams,
+    controller: PID,
+    reference: np.ndarray,
+    seeds: Sequence[int],
+    vary: bool = True,
+) -> ClosedLoopTrace:
+    """Run the controller against one actuator per seed; reference [°] at each PWM period.
+
+    vary: scale each trial's actuator by its own draw of PneuNetParams.trial_factors; False
+    keeps the nominal actuator for every trial (only the sensor noise differs).
+
+    Trial i draws its sensor noise, then its plant variation, from
+    numpy.random.default_rng(seeds[i]) alone, so a trial gives the same numbers alone or in a
+    batch.
+    """
+    steps = reference.size
+    trials = len(seeds)
+    rngs = [np.random.default_rng(s) for s in seeds]
+    noise = np.stack([rng.standard_normal(steps) for rng in rngs])
+    factors = np.stack([params.trial_factors(rng) for rng in rngs]) if vary else None
+    plant = PneuNetBatch(params, trials, factors)
+    controller.reset(trials)
+    full_scale = controller.output_limits[1]
+    t = np.arange(steps) * params.pwm_period
+    measured, theta, duty = (np.empty((trials, steps)) for _ in range(3))
+    for n in range(steps):
+        measured[:, n] = np.degrees(plant.read(noise[:, n]))
+        theta[:, n] = np.degrees(plant.theta)
+        u = controller(t[n], reference[n], measured[:, n])
+        duty[:, n] = np.floor(u) / full_scale  # analogWrite takes an integer count
+        plant.advance(duty[:, n])
+    return ClosedLoopTrace(t, reference, measured, theta, duty)
+
+
+def simulate(config: PneuNetPidConfig) -> ClosedLoopTrace:
+    """Every trial of a config as one batch."""
+    t = np.arange(config.steps) * config.plant.pwm_period
+    seeds = range(config.seed, config.seed + config.trials)
+    controller = config.controller.build(config.trials)
+    return run_closed_loop(config.plant, controller, reference_deg(config.reference, t), seeds)
+
+
+def trial_metrics(config: PneuNetPidConfig, trace: ClosedLoopTrace) -> dict[str, np.ndarray]:
+    """Per-trial E (2.7) on the sensor and on the true angle [°], and M (2.5)."""
+    keep = trace.t >= config.settle
+    ref = trace.reference[keep]
+    return {
+        "error": tracking_error(ref, trace.measured[:, keep]),
+        "error_true": tracking_error(ref, trace.theta[:, keep]),
+        "cost": tuning_cost(trace.t[keep], ref, trace.measured[:, keep]),
+        "saturation": np.mean((trace.duty <= 0) | (trace.duty >= 1), axis=1),
+    }
+
+
+class SimulatedRig:
+    """The tuner's view of the actuator: run one experiment with gains K, return its response.
+
+    Each call is a new experiment with fresh sensor noise (seed, seed + 1, ...) on the same,
+    nominal actuator, as in one tuning session on a rig.
+    """
+
+    def __init__(self, params: PneuNetParams, reference: np.ndarray, seed: int) -> None:
+        self.params = params
+        self.reference = np.asarray(reference, dtype=float)
+        self.seed = seed
+        self.calls = 0
+
+    def __call__(self, gains: np.ndarray) -> Response:
+        """One experiment from rest with constant gains [K_p, K_i, K_d]."""
+        schedule = GainSchedule("constant", np.asarray(gains, dtype=float)[None, :])
+        pid = PID(schedule, (0.0, 255.0))
+        trace = run_closed_loop(
+            self.params, pid, self.reference, [self.seed + self.calls], vary=False
+        )
+        self.calls += 1
+        return Response(trace.t, trace.reference, trace.measured[0])
+
+
+@register("pneunet.pid", PneuNetPidConfig)
+def run_pneunet_pid(config: PneuNetPidConfig) -> Result:
+    """Simulate every trial; metrics are E's median and quartiles over trials, trace is trial 0."""
+    trace = simulate(config)
+    m = trial_metrics(config, trace)
+    q1, median, q3 = np.percentile(m["error"], [25, 50, 75])
+    metrics = {
+        "error_median_deg": float(median),
+        "error_q1_deg": float(q1),
+        "error_q3_deg": float(q3),
+        "error_true_median_deg": float(np.median(m["error_true"])),
+        "cost_median": float(np.median(m["cost"])),
+        "saturation_fraction": float(np.mean(m["saturation"])),
+    }
+    columns = {
+        "t": trace.t,
+        "theta_ref_deg": trace.reference,
+        "theta_meas_deg": trace.measured[0],
+        "theta_deg": trace.theta[0],
+        "duty": trace.duty[0],
+    }
+    return Result(metrics=metrics, trace=columns)

@@ -1,0 +1,157 @@
+"""Simulated PneuNet bending actuator of chapter 2: PWM valve, chamber, bending, flex sensor.
+
+Chain (one PWM period T at a time, vectorised over a batch of trials):
+duty → solenoid valve (on for duty·T, off for the rest; the valve's opening lags its command
+by τ_v) → chamber pressure, a first-order lag τ_p towards supply·opening (so the mean
+pressure is proportional to duty, Sect. 2.4.1.2) → optional play (hysteresis) → saturating
+pressure-to-angle map → lightly damped second-order bending (exact over a period for the
+period's mean pressure) → flex sensor on a 10-bit ADC.
+The book gives the valve period only; every other number is chosen and explained below and
+in docs/deviations.md (Chapter 2).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated
+
+import numpy as np
+from pydantic import Field, model_validator
+from scipy.linalg import expm
+
+from articula.validation import StrictModel
+
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+
+
+class PneuNetParams(StrictModel):
+    """Constants of the simulated PneuNet in SI units, with the source or reason of each."""
+
+    # Valve switching period, Sect. 2.4.1.2: T = 1/30 s.
+    pwm_period: Positive = 1.0 / 30.0  # [s]
+    # Cheap solenoid valves need ~0.2 s to open or close fully: 3τ_v = 0.2 s.
+    valve_tau: Positive = 0.2 / 3.0  # [s]
+    # Supply pressure: PneuNets of Dragon Skin 10 are driven at a few tens of kPa.
+    supply_pressure: Positive = 50e3  # [Pa]
+    # Chamber fill/vent time constant through the valve orifice; sets, with the valve lag, the
+    # bandwidth (tracks 0.5 Hz, not 5 Hz, Sect. 2.4.2.2); calibrated, not measured.
+    chamber_tau: Positive = 0.25  # [s]
+    # Saturating map θ_eq = θ_max (1 − exp(−p/p_c)): 90° at ~78 % of supply, ~100° at full.
+    theta_max: Positive = math.radians(120.0)  # [rad]
+    pressure_scale: Positive = 27.9e3  # [Pa] p_c
+    # Bending: a free PneuNet finger swings at a few Hz and its silicone damps it little.
+    natural_frequency: Positive = 2 * math.pi * 3.0  # [rad/s]
+    damping_ratio: Annotated[float, Field(gt=0, lt=1, allow_inf_nan=False)] = 0.15
+    # Optional hysteresis: width of a play operator on the pressure (0: none).
+    hysteresis: NonNegative = 0.0  # [Pa]
+    # Flex sensor mapped linearly to volts (the book fits resistance to angle from data).
+    sensor_zero: NonNegative = 1.0  # [V] at 0°
+    sensor_gain: Positive = 2.5 / (math.pi / 2)  # [V/rad]: 2.5 V over 0-90°
+    # Flex-sensor dividers on an Arduino ADC wander by a couple of counts: σ ≈ 2 LSB ≈ 0.35°.
+    sensor_noise: NonNegative = math.radians(0.35)  # [rad] σ of the angle noise
+    adc_bits: Annotated[int, Field(ge=0, le=24)] = 10  # 0: no quantisation
+    adc_vref: Positive = 5.0  # [V]
+    # Structural uncertainty between trials (the chapter's subject): the pump's pressure, the
+    # chamber's fill time and the bending reach of each trial are scaled by 1 + spread·N(0, 1),
+    # clipped to [0.5, 1.5]. Chosen as a plausible rig-to-rig drift, not fitted to the book.
+    trial_spread: Annotated[float, Field(ge=0, le=0.2, allow_inf_nan=False)] = 0.05
+
+    @model_validator(mode="after")
+    def _check(self) -> PneuNetParams:
+        if 0.5 * self.chamber_tau <= self.valve_tau <= 1.5 * self.chamber_tau:
+            raise ValueError(
+                "valve_tau must lie outside chamber_tau × [0.5, 1.5] (the exact update divides "
+                "by τ_v − τ_p, and trials scale τ_p by up to ±50 %)"
+            )
+        reach = self.theta_max * (1 - math.exp(-self.supply_pressure / self.pressure_scale))
+        if reach <= math.radians(90.0):
+            raise ValueError(
+                f"full supply bends only {math.degrees(reach):.1f}°; the book's range is "
+                "0-90°, so raise supply_pressure or theta_max"
+            )
+        return self
+
+    def equilibrium_angle(
+        self, pressure: np.ndarray, reach: np.ndarray | float = 1.0
+    ) -> np.ndarray:
+        """Static bending angle [rad] at chamber pressure [Pa] (saturating map), × reach."""
+        theta = self.theta_max * -np.expm1(-np.maximum(pressure, 0.0) / self.pressure_scale)
+        return reach * theta
+
+    def trial_factors(self, rng: np.random.Generator) -> np.ndarray:
+        """Scales of [supply pressure, chamber τ, bending reach] for one trial."""
+        return np.clip(1.0 + self.trial_spread * rng.standard_normal(3), 0.5, 1.5)
+
+
+class PneuNetBatch:
+    """State of `trials` actuators at rest, advanced one PWM period at a time.
+
+    factors: (trials, 3) scales of supply pressure, chamber τ and bending reach per trial
+    (PneuNetParams.trial_factors); None: the nominal actuator for every trial.
+    """
+
+    def __init__(
+        self, params: PneuNetParams, trials: int, factors: np.ndarray | None = None
+    ) -> None:
+        self.params = params
+        f = np.ones((trials, 3)) if factors is None else np.asarray(factors, dtype=float)
+        self.supply = params.supply_pressure * f[:, 0]
+        self.chamber_tau = params.chamber_tau * f[:, 1]
+        self.reach = f[:, 2]
+        wn, zeta = params.natural_frequency, params.damping_ratio
+        A = np.array([[0.0, 1.0], [-(wn**2), -2 * zeta * wn]])
+        self._bending = expm(A * params.pwm_period)  # transition of [θ − θ_eq, θ'] over T
+        self.valve = np.zeros(trials)  # opening in [0, 1]
+        self.pressure = np.zeros(trials)  # [Pa]
+        self.played = np.zeros(trials)  # [Pa] pressure after the play operator
+        self.theta = np.zeros(trials)  # [rad]
+        self.omega = np.zeros(trials)  # [rad/s]
+
+    def advance(self, duty: np.ndarray) -> None:
+        """Apply `duty` in [0, 1] (one per trial) for one PWM period."""
+        p = self.params
+        d = np.minimum(np.maximum(duty, 0.0), 1.0)
+        T = p.pwm_period
+        # Valve and chamber are linear between switchings: advance both exactly through the
+        # on-phase (command 1) and the off-phase (command 0) of the period.
+        start = self.pressure
+        self._linear_segment(1.0, d * T)
+        self._linear_segment(0.0, (1.0 - d) * T)
+        # The bending sees the pressure's mean over the period (trapezoid of its ends).
+        mean_p = 0.5 * (start + self.pressure)
+        if p.hysteresis > 0:
+            half = 0.5 * p.hysteresis
+            self.played = np.clip(self.played, mean_p - half, mean_p + half)
+            mean_p = self.played
+        target = p.equilibrium_angle(mean_p, self.reach)
+        # θ'' = ω_n²(θ_eq − θ) − 2ζω_n θ' is linear for a held θ_eq: exact over the period.
+        (a, b), (c, d) = self._bending
+        offset = self.theta - target
+        self.theta = target + a * offset + b * self.omega
+        self.omega = c * offset + d * self.omega
+
+    def _linear_segment(self, command: float, duration: np.ndarray) -> None:
+        """Exact solution of τ_v x' = u − x, τ_p p' = P_s x − p over `duration` [s]."""
+        p = self.params
+        tv, tp, ps = p.valve_tau, self.chamber_tau, self.supply
+        ev = np.exp(-duration / tv)
+        ep = np.exp(-duration / tp)
+        x0 = self.valve - command
+        # p(t) − P_s u = (p0 − P_s u) e_p + P_s x0 · τ_v/(τ_v − τ_p) · (e_v − e_p)
+        self.pressure = (
+            ps * command
+            + (self.pressure - ps * command) * ep
+            + ps * x0 * tv / (tv - tp) * (ev - ep)
+        )
+        self.valve = command + x0 * ev
+
+    def read(self, noise: np.ndarray) -> np.ndarray:
+        """Flex-sensor angle [rad] as the controller reads it: noise, 10-bit ADC, back to angle."""
+        p = self.params
+        volts = p.sensor_zero + p.sensor_gain * (self.theta + p.sensor_noise * noise)
+        if p.adc_bits:
+            lsb = p.adc_vref / 2**p.adc_bits
+            counts = np.minimum(np.maximum(np.floor(volts / lsb), 0), 2**p.adc_bits - 1)
+            volts = (counts + 0.5) * lsb  # mid-step reconstruction
+        return (volts - p.sensor_zero) / p.sensor_gain

@@ -1,0 +1,182 @@
+"""Time simulation of the six-chamber actuator with its 3/3 valves (compiled with numba).
+
+State: β (2) [rad], β' (2) [rad/s] and the six absolute chamber pressures [Pa]. Each chamber's
+air obeys dp/dt = n/V (R T ṁ − p dV/dt) with V = V_0 + a_i·β, so a closed (holding) chamber is
+a gas spring, and flow through the valve orifice (to or from the pump or the atmosphere) is
+where the air loses energy. Valves change position only at scheduled events.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from articula.errors import ConfigError
+from articula.plants.six_chamber import CHAMBERS, GAS_CONSTANT, SixChamberParams, volume_gradients
+
+VENT, HOLD, FILL = 0, 1, 2  # the three positions of each 3-port 3-position valve
+
+
+@dataclass(frozen=True)
+class ValveSchedule:
+    """Valve commands: at times[k] [s] chamber chambers[k] goes to position modes[k]."""
+
+    times: np.ndarray
+    chambers: np.ndarray
+    modes: np.ndarray
+
+    @staticmethod
+    def build(events: list[tuple[float, int, int]]) -> ValveSchedule:
+        """A schedule from (time [s], chamber, mode) tuples, sorted by time (stable)."""
+        for t, chamber, mode in events:
+            if not (0 <= chamber < CHAMBERS) or mode not in (VENT, HOLD, FILL):
+                raise ConfigError("valve", f"bad event (t={t}, chamber={chamber}, mode={mode})")
+        ordered = sorted(events, key=lambda e: e[0])
+        return ValveSchedule(
+            np.array([e[0] for e in ordered], dtype=float),
+            np.array([e[1] for e in ordered], dtype=np.int64),
+            np.array([e[2] for e in ordered], dtype=np.int64),
+        )
+
+
+@dataclass(frozen=True)
+class Simulation:
+    """Recorded samples: t [s], β (n, 2) [rad], gauge pressures (n, 6) [Pa], valve modes."""
+
+    t: np.ndarray
+    beta: np.ndarray
+    rate: np.ndarray
+    gauge: np.ndarray
+    modes: np.ndarray
+
+
+def _constants(p: SixChamberParams) -> np.ndarray:
+    """Flat constants for the compiled right-hand side."""
+    return np.array([
+        p.inertia, p.stiffness, p.damping, p.chamber_volume, p.polytropic,
+        GAS_CONSTANT * p.temperature, p.discharge * p.orifice_area, p.flow_transition,
+        p.atmosphere, p.atmosphere + p.supply, p.stiffening / p.supply,
+    ])  # fmt: skip
+
+
+def simulate(
+    p: SixChamberParams,
+    schedule: ValveSchedule,
+    duration: float,
+    dt: float = 1e-4,
+    record_every: int = 10,
+    beta0: tuple[float, float] = (0.0, 0.0),
+    rate0: tuple[float, float] = (0.0, 0.0),
+    modes0: np.ndarray | None = None,
+) -> Simulation:
+    """Integrate from rest at atmospheric pressure (or β0, β'0) by RK4 with step dt [s]."""
+    if not (0 < dt <= 1e-3) or duration <= 0 or record_every < 1:
+        raise ConfigError("dt", f"need 0 < dt <= 1 ms and duration > 0 (got {dt}, {duration})")
+    steps = round(duration / dt)
+    modes = np.full(CHAMBERS, VENT, np.int64) if modes0 is None else np.array(modes0, np.int64)
+    y0 = np.concatenate([beta0, rate0, np.full(CHAMBERS, p.atmosphere)])
+    t, y, m = _integrate(
+        y0, modes, _constants(p), volume_gradients(p), schedule.times, schedule.chambers,
+        schedule.modes, dt, steps, record_every,
+    )  # fmt: skip
+    return Simulation(t, y[:, 0:2], y[:, 2:4], y[:, 4:] - p.atmosphere, m)
+
+
+@njit(cache=True, error_model="numpy")
+def orifice_flow(upstream: float, downstream: float, rt: float, cda: float, trans: float) -> float:
+    """Mass flow [kg/s] through an orifice, sharp-edged above `trans` [Pa], linear below."""
+    dp = upstream - downstream
+    rho = max(upstream, downstream) / rt  # density on the high side, ideal gas
+    return cda * math.sqrt(2.0 * rho) * dp / (dp * dp + trans * trans) ** 0.25
+
+
+@njit(cache=True, error_model="numpy")
+def _rhs(y: np.ndarray, modes: np.ndarray, c: np.ndarray, a: np.ndarray) -> np.ndarray:
+    inertia, stiff, damp, v0, n, rt, cda, trans, p_atm, p_sup, per_pa = c
+    dy = np.empty_like(y)
+    inflated = 0.0
+    for i in range(6):
+        inflated += max(y[4 + i] - p_atm, 0.0)
+    stiff = stiff * (1.0 + per_pa * inflated)
+    tx = -stiff * y[0] - damp * y[2]
+    ty = -stiff * y[1] - damp * y[3]
+    for i in range(6):
+        p = y[4 + i]
+        gauge = p - p_atm
+        tx += gauge * a[i, 0]  # generalised force of a chamber, V E c P of Sect. 3.2.2
+        ty += gauge * a[i, 1]
+        volume = v0 + a[i, 0] * y[0] + a[i, 1] * y[1]
+        dvol = a[i, 0] * y[2] + a[i, 1] * y[3]
+        if modes[i] == 2:
+            mdot = orifice_flow(p_sup, p, rt, cda, trans)
+        elif modes[i] == 0:
+            mdot = orifice_flow(p_atm, p, rt, cda, trans)
+        else:
+            mdot = 0.0
+        dy[4 + i] = n / volume * (rt * mdot - p * dvol)  # polytropic air in a moving chamber
+    dy[0] = y[2]
+    dy[1] = y[3]
+    dy[2] = tx / inertia  # I θ'' = V E c P − V E k² θ − b θ' (Sect. 3.2.2)
+    dy[3] = ty / inertia
+    return dy
+
+
+@njit(cache=True, error_model="numpy")
+def _integrate(
+    y0: np.ndarray, modes: np.ndarray, c: np.ndarray, a: np.ndarray, ev_t: np.ndarray,
+    ev_c: np.ndarray, ev_m: np.ndarray, dt: float, steps: int, every: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    n_rec = steps // every + 1
+    ts = np.empty(n_rec)
+    ys = np.empty((n_rec, y0.size))
+    ms = np.empty((n_rec, 6), np.int64)
+    y = y0.copy()
+    k = 0
+    rec = 0
+    for step in range(steps + 1):
+        t = step * dt
+        while k < ev_t.size and ev_t[k] <= t + 0.5 * dt:
+            modes[ev_c[k]] = ev_m[k]
+            k += 1
+        if step % every == 0:
+            ts[rec] = t
+            ys[rec] = y
+            ms[rec] = modes
+            rec += 1
+        if step == steps:
+            break
+        k1 = _rhs(y, modes, c, a)
+        k2 = _rhs(y + 0.5 * dt * k1, modes, c, a)
+        k3 = _rhs(y + 0.5 * dt * k2, modes, c, a)
+        k4 = _rhs(y + dt * k3, modes, c, a)
+        y = y + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+    return ts[:rec], ys[:rec], ms[:rec]
+
+
+def fill_time(p: SixChamberParams, gauge: float, dt: float = 1e-5) -> float:
+    """Valve open time [s] that fills a still, straight chamber from 0 to `gauge` [Pa].
+
+    The firmware sets a pressure by the fill valve's open time (Sect. 3.2.3: expansion grows
+    with the open time); this is that time for the modelled orifice. inf at or above supply.
+    """
+    if gauge <= 0:
+        return 0.0
+    if gauge >= p.supply * (1 - 1e-6):
+        return math.inf
+    return float(_fill_time(_constants(p), p.atmosphere + gauge, dt))
+
+
+@njit(cache=True, error_model="numpy")
+def _fill_time(c: np.ndarray, target: float, dt: float) -> float:
+    v0, n, rt, cda, trans, p_atm, p_sup = c[3], c[4], c[5], c[6], c[7], c[8], c[9]
+    p = p_atm
+    t = 0.0
+    while True:
+        dp = n / v0 * rt * orifice_flow(p_sup, p, rt, cda, trans)
+        if p + dt * dp >= target:
+            return t + (target - p) / dp  # linear within the last step
+        p += dt * dp
+        t += dt

@@ -1,0 +1,190 @@
+"""Chapter 3 experiment: metrics, the damping policy, bad input, calibration and the CLI."""
+
+from __future__ import annotations
+
+import math
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from articula.control.damping import DampingPolicy
+from articula.errors import ConfigError
+from articula.experiments.ch3 import (
+    DeactuationConfig,
+    oscillation_metrics,
+    run_deactuation,
+    run_metrics,
+    schedule,
+    simulate,
+)
+from articula.experiments.ch3_calibration import calibrate, undamped
+from articula.experiments.registry import parse_config
+from articula.plants.orientation_sensor import OrientationSensorParams
+from articula.plants.six_chamber import SixChamberParams
+from articula.plants.six_chamber_sim import FILL, HOLD, VENT, fill_time
+
+P = SixChamberParams()
+IDEAL = OrientationSensorParams(ideal=True)
+CONFIGS = Path(str(resources.files("articula.experiments") / "configs" / "ch3"))
+
+
+def metrics(**damping) -> dict[str, float]:
+    config = DeactuationConfig(sensor=IDEAL, damping=DampingPolicy(**damping))
+    return run_metrics(simulate(config), config.band_deg)
+
+
+# ----- metrics ------------------------------------------------------------------------------------
+
+
+def test_oscillation_metrics_of_a_damped_cosine():
+    t = np.arange(0, 5, 1e-4)
+    sigma, w = 2.0, 2 * math.pi
+    angle = np.where(t < 1, 1.0, np.exp(-sigma * (t - 1)) * np.cos(w * (t - 1)))
+    m = oscillation_metrics(t, angle, 1.0, band=0.1)
+    assert m["start"] == 1.0
+    # First trough where tan(wt) = −σ/w; the envelope e^{-σt} reaches the band at ln(10)/σ,
+    # and the last exit from the band comes at most half a period before that.
+    t1 = (math.pi - math.atan(sigma / w)) / w
+    trough = -math.exp(-sigma * t1) * math.cos(w * t1)
+    assert m["peak"] == pytest.approx(trough, rel=1e-6)
+    assert m["overshoot"] == pytest.approx(trough, rel=1e-6)
+    assert math.log(10) / sigma - 0.5 < m["settling"] <= math.log(10) / sigma
+
+
+def test_metrics_of_a_response_that_never_crosses_or_settles():
+    t = np.linspace(0, 2, 2001)
+    m = oscillation_metrics(t, np.exp(-t), 0.0, band=0.01)
+    assert m["peak"] == 0.0 and m["overshoot"] == 0.0 and math.isnan(m["settling"])
+
+
+# ----- the damping policy -------------------------------------------------------------------------
+
+
+def test_no_damping_no_events():
+    assert DampingPolicy().events(P, np.eye(6)[0] * P.supply, 1.0) == []
+
+
+def test_pulse_goes_to_the_opposite_chamber_at_delta_times_the_pressure():
+    policy = DampingPolicy(delta=0.5, start=0.02, length=0.05)
+    events = policy.events(P, np.eye(6)[1] * 80e3, 1.0)
+    t_open = fill_time(P, 40e3)
+    assert 0 < t_open < 0.05
+    assert events == [(1.02, 4, FILL), (1.02 + t_open, 4, HOLD), (1.07, 4, VENT)]
+    assert policy.pulse_length(P, 80e3) == pytest.approx(0.05)
+    # Shorter than the fill: it vents once filled, so the chamber still reaches δ·P.
+    brief = DampingPolicy(delta=0.5, length=0.001)
+    assert brief.events(P, np.eye(6)[1] * 80e3, 1.0)[-1] == (1.0 + t_open, 4, VENT)
+
+
+def test_between_chambers_the_pulse_is_shared_by_two_opposite_chambers():
+    config = DeactuationConfig(side_deg=30.0, damping=DampingPolicy(delta=0.4))
+    s = schedule(config)
+    pulsed = set(s.chambers[(s.times >= config.hold) & (s.modes == FILL)].tolist())
+    assert pulsed == {3, 4}
+
+
+def test_a_short_hold_vents_while_filling():
+    s = schedule(DeactuationConfig(side_deg=30.0, hold=0.001, after=0.2))
+    assert HOLD not in s.modes.tolist()
+    assert s.modes[-1] == VENT
+
+
+def test_simultaneous_held_pulse_swings_further_past_rest():
+    """The opposite chamber pushes the way the body returns (Sect. 3.2.4 against Fig. 3.5)."""
+    assert metrics(delta=0.5, length=0.1)["peak_true_deg"] > metrics()["peak_true_deg"] + 5
+
+
+def test_a_delayed_pulse_damps_the_swings_after_the_first():
+    free = metrics()
+    timed = metrics(delta=0.31, start=0.14, length=0.045)
+    assert timed["settling_true_s"] < 0.3 * free["settling_true_s"]
+    assert timed["peak_true_deg"] == pytest.approx(free["peak_true_deg"], abs=0.1)
+
+
+# ----- calibration --------------------------------------------------------------------------------
+
+
+def test_defaults_reproduce_the_books_undamped_deactuation():
+    m = undamped(P)
+    assert 18.0 <= m["peak_true_deg"] <= 20.0
+    assert 0.9 <= m["settling_true_s"] <= 1.0
+
+
+@pytest.mark.slow
+def test_calibration_returns_the_defaults():
+    c = calibrate()
+    assert c.youngs_modulus == pytest.approx(P.youngs_modulus, rel=0.01)
+    assert c.damping == pytest.approx(P.damping, rel=0.02)
+
+
+# ----- bad input ----------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("data", "field"),
+    [
+        ({"damping": {"delta": 1.2}}, "damping.delta"),
+        ({"damping": {"start": -0.1}}, "damping.start"),
+        ({"actuator": {"supply": 0.0}}, "actuator.supply"),
+        ({"sensor": {"rate": 0.0}}, "sensor.rate"),
+        ({"side": 30.0}, "side"),
+        ({"pressure": 2e5}, "config"),
+    ],
+)
+def test_bad_config_names_the_field(data, field):
+    with pytest.raises(ConfigError) as exc:
+        parse_config({"experiment": "softarm.damping", **data})
+    assert exc.value.field == field
+
+
+@pytest.mark.parametrize(
+    ("data", "words"),
+    [
+        ({"pressure": 2e5}, "above the supply"),
+        ({"dt": 3e-4}, "must divide"),
+        ({"dt": 1e-6, "after": 10.0}, "5e6 steps"),
+    ],
+)
+def test_cross_field_checks_say_what_is_wrong(data, words):
+    with pytest.raises(ConfigError) as exc:
+        DeactuationConfig(**data)
+    assert words in exc.value.problem
+
+
+def test_registered_run_returns_trace_columns_of_one_length():
+    result = run_deactuation(DeactuationConfig(hold=0.5, after=0.3))
+    lengths = {v.size for v in result.trace.values()}
+    assert len(lengths) == 1
+    assert {"t", "bend", "bend_sensor", "p0", "valve5"} <= set(result.trace)
+    assert set(result.metrics) >= {"peak_deg", "overshoot_pct", "settling_s"}
+
+
+# ----- command line -------------------------------------------------------------------------------
+
+
+def test_sweep_file_runs_through_articula_sweep(cli, tmp_path):
+    proc = cli("sweep", CONFIGS / "delta_quick.toml", "--out", tmp_path / "sweep", "--json")
+    assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "sweep" / "results.parquet").is_file()
+
+
+def test_reproduce_ch3_json(cli, one_json, tmp_path):
+    out = tmp_path / "report"
+    proc = cli("reproduce", "ch3", "--out", out, "--json")
+    assert proc.returncode == 0, proc.stderr
+    ch3 = one_json(proc.stdout)["chapters"]["ch3"]
+    n = len(ch3["delta"])
+    assert n >= 5 and ch3["delta"][0] == 0.0
+    assert len(ch3["peak_deg"]) == len(ch3["settling_s"]) == n
+    assert all(isinstance(x, float) for x in ch3["peak_deg"] + ch3["settling_s"])
+    assert set(ch3["claims"]) == {
+        "damping grows with delta", "about 2 deg and 0.5 s near delta = 0.5",
+    }  # fmt: skip
+    assert all(isinstance(v, bool) for v in ch3["claims"].values())
+    text = (out / "report.md").read_text()
+    assert "## Chapter 3" in text
+    for name in ("fig3_7", "timing", "search"):
+        assert (out / "ch3" / f"{name}.png").is_file()
+    assert 18.0 <= ch3["peak_deg"][0] <= 20.0

@@ -1,0 +1,242 @@
+"""Six-chamber actuator (chapter 3): geometry, body and air dynamics, valves, sensor, allocation."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+
+from articula.control.chamber_allocation import bend_direction, side_pressures
+from articula.errors import ConfigError
+from articula.experiments.ch3 import DeactuationConfig, simulate
+from articula.plants.orientation_sensor import (
+    OrientationSensorParams,
+    bend_from_euler,
+    euler_from_bend,
+    read,
+)
+from articula.plants.six_chamber import (
+    CHAMBERS,
+    SixChamberParams,
+    chamber_directions,
+    gas_stiffness,
+    natural_frequency,
+    static_bend,
+    volume_gradients,
+)
+from articula.plants.six_chamber_sim import FILL, HOLD, ValveSchedule, fill_time
+from articula.plants.six_chamber_sim import simulate as simulate_plant
+
+P = SixChamberParams()
+IDEAL = OrientationSensorParams(ideal=True)
+SEALED = np.full(CHAMBERS, HOLD)
+
+
+def rotation(deg: float) -> np.ndarray:
+    c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+    return np.array([[c, -s], [s, c]])
+
+
+def total_energy(p: SixChamberParams, sim) -> np.ndarray:
+    """Body energy plus, per sealed chamber, its air's internal energy and p_atm·V (Joules)."""
+    mech = 0.5 * p.inertia * np.sum(sim.rate**2, 1) + 0.5 * p.stiffness * np.sum(sim.beta**2, 1)
+    volume = p.chamber_volume + sim.beta @ volume_gradients(p).T
+    absolute = sim.gauge + p.atmosphere
+    gas = absolute * volume / (p.polytropic - 1) + p.atmosphere * volume
+    return mech + gas.sum(1)
+
+
+# ----- geometry ---------------------------------------------------------------------------------
+
+
+def test_second_moment_matches_pixel_integration():
+    n = 2001
+    x = np.linspace(-P.outer_radius, P.outer_radius, n)
+    X, Y = np.meshgrid(x, x)
+    solid = np.hypot(X, Y) <= P.outer_radius
+    for d in chamber_directions() * P.chamber_circle:
+        solid &= (X - d[0]) ** 2 + (Y - d[1]) ** 2 > P.chamber_radius**2
+    cell = (x[1] - x[0]) ** 2
+    assert P.section_area == pytest.approx(solid.sum() * cell, rel=2e-3)
+    assert P.second_moment == pytest.approx((Y**2 * solid).sum() * cell, rel=2e-3)
+    assert P.second_moment == pytest.approx((X**2 * solid).sum() * cell, rel=2e-3)
+
+
+def test_book_model_constants_follow_from_beam_bending():
+    # V E k² = E I_a / L and V E c = A_c r_p (Sect. 3.2.2 with ε = y κ of a bent beam).
+    assert P.stiffness == pytest.approx(P.youngs_modulus * P.second_moment / P.length)
+    assert P.volume * P.youngs_modulus * P.strain_per_pressure == pytest.approx(P.lever)
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "words"),
+    [
+        ("chamber_circle", 0.037, "outer_radius"),
+        ("chamber_circle", 0.009, "overlap"),
+        ("chamber_length", 0.2, "length"),
+        ("density", -1.0, "greater than 0"),
+    ],
+)
+def test_bad_geometry_names_the_field(field, value, words):
+    with pytest.raises(ConfigError) as exc:
+        SixChamberParams(**{field: value})
+    message = str(exc.value)
+    assert field in message and str(value) in message and words in message
+
+
+# ----- the four physics checks of issue 6 -------------------------------------------------------
+
+
+def test_energy_decays_with_no_input():
+    beta0 = (math.radians(10.0), math.radians(-4.0))
+    sim = simulate_plant(P, ValveSchedule.build([]), 2.0, beta0=beta0, modes0=SEALED)
+    energy = total_energy(P, sim)
+    assert np.all(np.diff(energy) <= 1e-12 * energy[0])
+    excess = energy - energy[-1]
+    assert excess[-1] < 1e-3 * excess[0]
+    # Vented chambers (the idle state) lose it too; only the body's energy is left to count.
+    vented = simulate_plant(P, ValveSchedule.build([]), 2.0, beta0=beta0)
+    body = 0.5 * P.inertia * np.sum(vented.rate**2, 1) + 0.5 * P.stiffness * np.sum(
+        vented.beta**2, 1
+    )
+    assert body[-1] < 1e-4 * body[0]
+
+
+def test_energy_is_conserved_without_friction():
+    """The oracle behind the decay test: with b = 0 the sealed air stores and returns energy."""
+    p = P.model_copy(update={"damping": 0.0})
+    sim = simulate_plant(p, ValveSchedule.build([]), 0.5, beta0=(0.2, 0.1), modes0=SEALED)
+    energy = total_energy(p, sim)
+    swing = 0.5 * p.stiffness * 0.05
+    assert np.ptp(energy) < 1e-6 * swing
+
+
+@pytest.mark.parametrize("side", [0.0, 30.0, 75.0])
+def test_rotating_the_command_by_60_degrees_rotates_the_response(side):
+    damping = {"delta": 0.3, "start": 0.12, "length": 0.05}
+    runs = [
+        simulate(DeactuationConfig(side_deg=s, sensor=IDEAL, damping=damping, after=0.6))
+        for s in (side, side + 60.0)
+    ]
+    rotated = runs[0].sim.beta @ rotation(60.0).T
+    np.testing.assert_allclose(runs[1].sim.beta, rotated, atol=1e-9)
+    np.testing.assert_allclose(runs[1].sim.gauge, np.roll(runs[0].sim.gauge, 1, axis=1), atol=1e-6)
+    assert np.abs(runs[0].sim.beta).max() > math.radians(10)
+
+
+@pytest.mark.parametrize("pair", [(0, 3), (1, 4), (2, 5)])
+def test_opposite_equal_pressures_give_no_bend(pair):
+    events = [(0.0, c, FILL) for c in pair] + [(0.4, c, HOLD) for c in pair]
+    sim = simulate_plant(P, ValveSchedule.build(events), 0.8)
+    assert sim.gauge[:, pair[0]].max() > 0.9 * P.supply
+    np.testing.assert_allclose(sim.gauge[:, pair[0]], sim.gauge[:, pair[1]], atol=1e-9)
+    assert np.abs(sim.beta).max() < 1e-12
+    gauge = np.zeros(CHAMBERS)
+    gauge[list(pair)] = 70e3
+    assert np.abs(static_bend(P, gauge)).max() < 1e-15
+
+
+def test_natural_frequency_and_damping_ratio_match_the_free_response():
+    """Small free swing with every valve holding: I θ'' + b θ' + (V E k² + gas) θ = 0.
+
+    The air is sealed at atmospheric pressure with the body bent by θ0, so the gas spring
+    holds it toward θ0: the rest angle is θ0·K_gas/(K + K_gas).
+    """
+    wn, zeta = natural_frequency(P, sealed=True)
+    theta0 = math.radians(0.5)
+    rest = theta0 * gas_stiffness(P, P.atmosphere) / (P.stiffness + gas_stiffness(P, P.atmosphere))
+    sim = simulate_plant(P, ValveSchedule.build([]), 1.0, beta0=(theta0, 0.0), modes0=SEALED)
+    wd = wn * math.sqrt(1 - zeta**2)
+    t = sim.t
+    closed = rest + (theta0 - rest) * np.exp(-zeta * wn * t) * (
+        np.cos(wd * t) + zeta / math.sqrt(1 - zeta**2) * np.sin(wd * t)
+    )
+    np.testing.assert_allclose(sim.beta[:, 0], closed, atol=2e-3 * theta0)
+    # Without the gas spring the prediction is off by far more than that tolerance.
+    wn_body, _ = natural_frequency(P)
+    assert abs(wn_body - wn) / wn > 0.1
+
+
+def test_linear_frequency_of_vented_body_is_close_but_damped_more():
+    """Vented chambers pass air through their orifices: a softer spring and extra damping."""
+    wn, zeta = natural_frequency(P)
+    sim = simulate_plant(P, ValveSchedule.build([]), 1.0, beta0=(math.radians(2.0), 0.0))
+    x = sim.beta[:, 0]
+    up = np.nonzero((x[:-1] < 0) & (x[1:] >= 0))[0]
+    period = np.mean(np.diff(sim.t[up]))
+    assert 2 * math.pi / period == pytest.approx(wn * math.sqrt(1 - zeta**2), rel=0.1)
+    peaks = [x[a:b].max() for a, b in itertools.pairwise(up)]
+    measured_zeta = np.log(peaks[0] / peaks[1]) / (2 * math.pi)
+    assert measured_zeta > zeta
+
+
+# ----- statics, valves ----------------------------------------------------------------------------
+
+
+def test_steady_bend_matches_the_static_model():
+    # Connected to the pump the chamber sits at the supply pressure: the static model holds.
+    sim = simulate_plant(P, ValveSchedule.build([(0.0, 2, FILL)]), 4.0)
+    expected = static_bend(P, np.eye(CHAMBERS)[2] * P.supply)
+    np.testing.assert_allclose(sim.beta[-1], expected, rtol=1e-4)
+    assert expected @ chamber_directions()[2] < 0  # bends away from the chamber
+
+
+def test_pressure_stiffening_scales_the_steady_bend():
+    # V E k²·(1 + s p/supply) θ = A_c r_p p for one chamber held at the supply pressure.
+    p = P.model_copy(update={"stiffening": 0.8})
+    sim = simulate_plant(p, ValveSchedule.build([(0.0, 0, FILL)]), 4.0)
+    expected = static_bend(P, np.eye(CHAMBERS)[0] * P.supply) / 1.8
+    np.testing.assert_allclose(sim.beta[-1], expected, rtol=1e-4, atol=1e-12)
+
+
+def test_fill_time_brings_a_still_chamber_to_its_target():
+    target = 0.4 * P.supply
+    t_open = fill_time(P, target)
+    events = [(0.0, 0, FILL), (0.0, 3, FILL), (t_open, 0, HOLD), (t_open, 3, HOLD)]
+    sim = simulate_plant(P, ValveSchedule.build(events), 0.1, dt=1e-5, record_every=1)
+    assert sim.gauge[-1, 0] == pytest.approx(target, rel=2e-3)
+    assert fill_time(P, 0.0) == 0.0 and math.isinf(fill_time(P, P.supply))
+    assert fill_time(P, 0.2 * P.supply) < t_open < fill_time(P, 0.8 * P.supply)
+
+
+def test_bad_schedule_and_step_are_config_errors():
+    with pytest.raises(ConfigError):
+        ValveSchedule.build([(0.0, 6, FILL)])
+    with pytest.raises(ConfigError) as exc:
+        simulate_plant(P, ValveSchedule.build([]), 1.0, dt=0.01)
+    assert exc.value.field == "dt"
+
+
+# ----- sensor and allocation ----------------------------------------------------------------------
+
+
+def test_euler_angles_round_trip():
+    rng = np.random.default_rng(3)
+    beta = rng.uniform(-0.8, 0.8, (200, 2))
+    np.testing.assert_allclose(bend_from_euler(euler_from_bend(beta)), beta, atol=1e-12)
+    pure_x = euler_from_bend(np.array([[0.3, 0.0]]))[0]  # tilt toward +x is a pitch
+    np.testing.assert_allclose(pure_x, [0.0, 0.3, 0.0], atol=1e-12)
+
+
+def test_sensor_rate_and_noise():
+    t = np.arange(0, 2.0 + 1e-9, 1e-3)
+    beta = np.zeros((t.size, 2))
+    params = OrientationSensorParams(rate=50.0, noise_deg=0.5)
+    ts, euler = read(params, t, beta, np.random.default_rng(0))
+    assert ts.size == 101 and np.allclose(np.diff(ts), 0.02)
+    assert np.degrees(euler.std()) == pytest.approx(0.5, rel=0.1)
+    ts, euler = read(IDEAL, t, beta, np.random.default_rng(0))
+    assert ts.size == t.size and not euler.any()
+
+
+@pytest.mark.parametrize("side", [0.0, 17.0, 30.0, 60.0, 215.0, -40.0])
+def test_side_pressures_push_as_one_chamber(side):
+    pressures = side_pressures(side, 1.0)
+    assert np.all(pressures >= 0) and np.count_nonzero(pressures) <= 2
+    assert pressures.max() <= 1.0 + 1e-12
+    force = pressures @ chamber_directions()
+    np.testing.assert_allclose(force, [math.cos(math.radians(side)), math.sin(math.radians(side))],
+                               atol=1e-12)  # fmt: skip
+    np.testing.assert_allclose(bend_direction(side), -force, atol=1e-12)
