@@ -114,7 +114,9 @@ def reproduce(
     ] = "all",
     out_dir: OutDir = Path("report"),
     full: Annotated[bool, typer.Option("--full", help="Full-size runs instead of quick.")] = False,
-    workers: Annotated[int, typer.Option(min=1, help="Local worker processes.")] = 1,
+    workers: Annotated[
+        int, typer.Option(min=1, help="Local worker processes (default: one per core).")
+    ] = os.cpu_count() or 1,
     as_json: JsonFlag = False,
 ) -> None:
     """Reproduce the book's figures and tables into OUT/report.md and PNG figures."""
