@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from articula.control.chamber_allocation import side_pressures
 from articula.control.damping import DampingPolicy
 from articula.errors import ConfigError
 from articula.experiments.ch3 import (
@@ -23,7 +24,7 @@ from articula.experiments.ch3_calibration import calibrate, undamped
 from articula.experiments.registry import parse_config
 from articula.plants.orientation_sensor import OrientationSensorParams
 from articula.plants.six_chamber import SixChamberParams
-from articula.plants.six_chamber_sim import FILL, HOLD, VENT, fill_time
+from articula.plants.six_chamber_sim import FILL, HOLD, REGULATE, VENT, fill_time
 
 P = SixChamberParams()
 IDEAL = OrientationSensorParams(ideal=True)
@@ -72,7 +73,6 @@ def test_pulse_goes_to_the_opposite_chamber_at_delta_times_the_pressure():
     t_open = fill_time(P, 40e3)
     assert 0 < t_open < 0.05
     assert events == [(1.02, 4, FILL), (1.02 + t_open, 4, HOLD), (1.07, 4, VENT)]
-    assert policy.pulse_length(P, 80e3) == pytest.approx(0.05)
     # Shorter than the fill: it vents once filled, so the chamber still reaches δ·P.
     brief = DampingPolicy(delta=0.5, length=0.001)
     assert brief.events(P, np.eye(6)[1] * 80e3, 1.0)[-1] == (1.0 + t_open, 4, VENT)
@@ -83,6 +83,24 @@ def test_between_chambers_the_pulse_is_shared_by_two_opposite_chambers():
     s = schedule(config)
     pulsed = set(s.chambers[(s.times >= config.hold) & (s.modes == FILL)].tolist())
     assert pulsed == {3, 4}
+
+
+def test_a_side_between_chambers_is_held_at_its_commanded_pressure():
+    """Regulated chambers reach the vent command at the commanded pressure (Eq. 3.4's P)."""
+    for side, gauge in ((30.0, None), (0.0, 50e3), (75.0, 80e3)):
+        config = DeactuationConfig(side_deg=side, pressure=gauge, sensor=IDEAL, after=0.05)
+        run = simulate(config)
+        commanded = side_pressures(side, config.gauge)
+        at_vent = run.sim.gauge[np.searchsorted(run.sim.t, config.hold) - 1]
+        np.testing.assert_allclose(at_vent, commanded, atol=0.01 * config.gauge)
+        s = schedule(config)
+        first = {int(c): int(m) for c, m in zip(s.chambers[::-1], s.modes[::-1], strict=True)}
+        for i in np.nonzero(commanded)[0]:
+            assert first[i] == (FILL if commanded[i] >= P.supply else REGULATE)
+    # Between chambers the bend equals one chamber's at full supply (force vectors add).
+    angle = [run_metrics(simulate(DeactuationConfig(side_deg=s, sensor=IDEAL, after=0.05)),
+                         1.0)["deactuation_angle_deg"] for s in (0.0, 30.0)]  # fmt: skip
+    assert angle[1] == pytest.approx(angle[0], rel=0.01)
 
 
 def test_a_short_hold_vents_while_filling():
@@ -98,7 +116,7 @@ def test_simultaneous_held_pulse_swings_further_past_rest():
 
 def test_a_delayed_pulse_damps_the_swings_after_the_first():
     free = metrics()
-    timed = metrics(delta=0.31, start=0.14, length=0.045)
+    timed = metrics(delta=0.3, start=0.15, length=0.045)
     assert timed["settling_true_s"] < 0.3 * free["settling_true_s"]
     assert timed["peak_true_deg"] == pytest.approx(free["peak_true_deg"], abs=0.1)
 
@@ -109,7 +127,8 @@ def test_a_delayed_pulse_damps_the_swings_after_the_first():
 def test_defaults_reproduce_the_books_undamped_deactuation():
     m = undamped(P)
     assert 18.0 <= m["peak_true_deg"] <= 20.0
-    assert 0.9 <= m["settling_true_s"] <= 1.0
+    # "about 0.9 s" (Sect. 3.1) and "about 1 s" (Sect. 3.4); settling is a staircase in b.
+    assert 0.85 <= m["settling_true_s"] <= 1.05
 
 
 @pytest.mark.slow
@@ -130,7 +149,9 @@ def test_calibration_returns_the_defaults():
         ({"actuator": {"supply": 0.0}}, "actuator.supply"),
         ({"sensor": {"rate": 0.0}}, "sensor.rate"),
         ({"side": 30.0}, "side"),
-        ({"pressure": 2e5}, "config"),
+        ({"pressure": 2e5}, "pressure"),
+        ({"dt": 3e-4}, "dt"),
+        ({"actuator": {"chamber_length": 0.2}}, "actuator.chamber_length"),
     ],
 )
 def test_bad_config_names_the_field(data, field):
@@ -179,12 +200,16 @@ def test_reproduce_ch3_json(cli, one_json, tmp_path):
     assert n >= 5 and ch3["delta"][0] == 0.0
     assert len(ch3["peak_deg"]) == len(ch3["settling_s"]) == n
     assert all(isinstance(x, float) for x in ch3["peak_deg"] + ch3["settling_s"])
+    assert all(x == round(x, 6) for x in ch3["settling_s"])  # sample instants, no float noise
     assert set(ch3["claims"]) == {
         "damping grows with delta", "about 2 deg and 0.5 s near delta = 0.5",
     }  # fmt: skip
     assert all(isinstance(v, bool) for v in ch3["claims"].values())
     text = (out / "report.md").read_text()
     assert "## Chapter 3" in text
+    # The assumed valve constants' sensitivity and the solenoid-time flags are computed.
+    assert "| orifice 0.5 mm |" in text and "| flow_transition 5000 Pa |" in text
+    assert "† Open time below 10 ms" in text
     for name in ("fig3_7", "timing", "search"):
         assert (out / "ch3" / f"{name}.png").is_file()
     assert 18.0 <= ch3["peak_deg"][0] <= 20.0

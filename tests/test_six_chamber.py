@@ -26,7 +26,7 @@ from articula.plants.six_chamber import (
     static_bend,
     volume_gradients,
 )
-from articula.plants.six_chamber_sim import FILL, HOLD, ValveSchedule, fill_time
+from articula.plants.six_chamber_sim import FILL, HOLD, REGULATE, ValveSchedule, fill_time
 from articula.plants.six_chamber_sim import simulate as simulate_plant
 
 P = SixChamberParams()
@@ -65,9 +65,16 @@ def test_second_moment_matches_pixel_integration():
 
 
 def test_book_model_constants_follow_from_beam_bending():
-    # V E k² = E I_a / L and V E c = A_c r_p (Sect. 3.2.2 with ε = y κ of a bent beam).
+    # V E k² = E I_a / L and V E c = A_c r_p L_c/L (Sect. 3.2.2 with ε = y κ of a bent beam).
     assert P.stiffness == pytest.approx(P.youngs_modulus * P.second_moment / P.length)
     assert P.volume * P.youngs_modulus * P.strain_per_pressure == pytest.approx(P.lever)
+    # Constant curvature: the chamber's axis at r_p from the neutral axis, over its length
+    # L_c, lengthens by r_p·(θ L_c/L) when the top turns by θ.
+    theta = 0.1
+    dv = (volume_gradients(P) @ np.array([-theta, 0.0]))[0]
+    assert dv == pytest.approx(P.chamber_area * P.chamber_circle * theta * P.chamber_length
+                               / P.length)  # fmt: skip
+    assert P.model_copy(update={"chamber_length": P.length}).lever > P.lever
 
 
 @pytest.mark.parametrize(
@@ -201,12 +208,49 @@ def test_fill_time_brings_a_still_chamber_to_its_target():
     assert fill_time(P, 0.2 * P.supply) < t_open < fill_time(P, 0.8 * P.supply)
 
 
-def test_bad_schedule_and_step_are_config_errors():
-    with pytest.raises(ConfigError):
-        ValveSchedule.build([(0.0, 6, FILL)])
+def test_regulated_chamber_holds_its_target_while_the_body_swings():
+    """REGULATE refills and vents against the bend; HOLD after a timed fill drifts."""
+    target = 0.5 * P.supply
+    regulated = simulate_plant(P, ValveSchedule.build([(0.0, 0, REGULATE, target)]), 3.0)
+    late = regulated.t >= 0.3
+    np.testing.assert_allclose(regulated.gauge[late, 0], target, rtol=0.01)
+    np.testing.assert_allclose(regulated.beta[-1], static_bend(P, np.eye(CHAMBERS)[0] * target),
+                               rtol=0.01, atol=1e-12)  # fmt: skip
+    held = simulate_plant(
+        P, ValveSchedule.build([(0.0, 0, FILL), (fill_time(P, target), 0, HOLD)]), 1.0
+    )
+    assert held.gauge[-1, 0] < 0.9 * target  # the bend expands the sealed chamber
+
+
+@pytest.mark.parametrize(
+    ("events", "field"),
+    [
+        ([(0.0, 6, FILL)], "events[0].chamber"),
+        ([(0.0, 1, FILL), (0.1, 2, 7)], "events[1].mode"),
+        ([(0.0, 1, REGULATE)], "events[0].target"),
+    ],
+)
+def test_bad_schedule_names_the_event(events, field):
     with pytest.raises(ConfigError) as exc:
-        simulate_plant(P, ValveSchedule.build([]), 1.0, dt=0.01)
-    assert exc.value.field == "dt"
+        ValveSchedule.build(events)
+    assert exc.value.field == field
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        ({"dt": 0.01}, "dt"),
+        ({"duration": 0.0}, "duration"),
+        ({"record_every": 0}, "record_every"),
+        ({"modes0": np.full(CHAMBERS, 3)}, "modes0"),
+        ({"modes0": np.zeros(5, int)}, "modes0"),
+    ],
+)
+def test_bad_simulation_arguments_name_the_argument(kwargs, field):
+    args = {"duration": 1.0, **kwargs}
+    with pytest.raises(ConfigError) as exc:
+        simulate_plant(P, ValveSchedule.build([]), **args)
+    assert exc.value.field == field
 
 
 # ----- sensor and allocation ----------------------------------------------------------------------

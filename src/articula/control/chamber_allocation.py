@@ -17,7 +17,7 @@ def side_pressures(side_deg: float, gauge: float) -> np.ndarray:
     the two nearest chambers (p_a ê_a + p_b ê_b = gauge·ê_side, both ≥ 0, neither above gauge).
     """
     side = float(side_deg) % 360.0
-    lower = int(side // 60.0) % CHAMBERS
+    lower = int(side // 60.0) % CHAMBERS  # % again: a tiny negative side_deg % 360.0 is 360.0
     alpha = math.radians(side - 60.0 * (side // 60.0))
     sixty = math.radians(60.0)
     pressures = np.zeros(CHAMBERS)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from typing import Annotated
 
 import numpy as np
@@ -44,14 +43,9 @@ class DampingPolicy(StrictModel):
                 continue
             opposite = (i + CHAMBERS // 2) % CHAMBERS
             t_fill = t_off + self.start
-            t_open = fill_time(p, self.delta * pressures[i])  # δ of Eq. (3.4) via open time
-            t_vent = t_fill + max(self.length, 0.0 if math.isinf(t_open) else t_open)
+            # δ of Eq. (3.4) via open time; finite, since δ ≤ 0.95 keeps δ·P below supply.
+            t_open = fill_time(p, self.delta * pressures[i])
             events.append((t_fill, opposite, FILL))
-            if math.isfinite(t_open):
-                events.append((t_fill + t_open, opposite, HOLD))
-            events.append((t_vent, opposite, VENT))  # after HOLD when hold = 0
+            events.append((t_fill + t_open, opposite, HOLD))
+            events.append((t_fill + max(self.length, t_open), opposite, VENT))  # after HOLD
         return events
-
-    def pulse_length(self, p: SixChamberParams, pressure: float) -> float:
-        """Time [s] the opposite chamber is not venting: `length`, or its fill time if longer."""
-        return max(self.length, fill_time(p, self.delta * pressure))

@@ -13,9 +13,9 @@ from articula.control.damping import DampingPolicy
 from articula.experiments.registry import Result, register
 from articula.plants.orientation_sensor import OrientationSensorParams, bend_from_euler, read
 from articula.plants.six_chamber import CHAMBERS, SixChamberParams, chamber_directions
-from articula.plants.six_chamber_sim import FILL, HOLD, VENT, Simulation, ValveSchedule, fill_time
+from articula.plants.six_chamber_sim import FILL, REGULATE, VENT, Simulation, ValveSchedule
 from articula.plants.six_chamber_sim import simulate as simulate_plant
-from articula.validation import StrictModel
+from articula.validation import StrictModel, field_error
 
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 RECORD_DT = 1e-3  # [s] trace sample interval
@@ -25,8 +25,10 @@ class DeactuationConfig(StrictModel):
     """One actuate-hold-deactuate run of Sect. 3.4 (Fig. 3.7); times [s], pressures gauge [Pa].
 
     side_deg [deg] is the pressurised side (chamber i at 60°·i; between chambers the two
-    nearest share it); pressure defaults to the pump's supply. The side is filled at t = 0,
-    vented at t = hold, and the run ends `after` seconds later. band_deg [deg] is the settling
+    nearest share it); pressure defaults to the pump's supply. The side is filled at t = 0 and
+    held at its pressure (a chamber below supply is pressure-regulated: its fill valve reopens
+    whenever the bend lets its pressure fall), vented at t = hold, and the run ends `after`
+    seconds later. band_deg [deg] is the settling
     band about rest.
     """
 
@@ -44,18 +46,21 @@ class DeactuationConfig(StrictModel):
     @model_validator(mode="after")
     def _check(self) -> DeactuationConfig:
         if self.pressure is not None and self.pressure > self.actuator.supply:
-            raise ValueError(
+            raise field_error(
+                "pressure",
                 f"pressure ({self.pressure:g} Pa) is above the supply "
-                f"({self.actuator.supply:g} Pa); lower it or raise actuator.supply"
+                f"({self.actuator.supply:g} Pa); lower it or raise actuator.supply",
             )
         if (self.hold + self.after) / self.dt > 5_000_000:
-            raise ValueError(
+            raise field_error(
+                "dt",
                 f"(hold + after)/dt is over 5e6 steps (dt = {self.dt:g} s); raise dt or shorten "
-                "the run"
+                "the run",
             )
         if abs(round(RECORD_DT / self.dt) * self.dt - RECORD_DT) > 1e-12:
-            raise ValueError(
-                f"dt ({self.dt:g} s) must divide the {RECORD_DT:g} s trace interval, e.g. 1e-4"
+            raise field_error(
+                "dt",
+                f"dt ({self.dt:g} s) must divide the {RECORD_DT:g} s trace interval, e.g. 1e-4",
             )
         return self
 
@@ -77,17 +82,22 @@ class Deactuation:
 
 
 def schedule(config: DeactuationConfig) -> ValveSchedule:
-    """Valve events: fill the side (open time per pressure), vent at `hold`, and the pulse."""
+    """Valve events: fill the side, hold it at its pressures, vent at `hold`, and the pulse.
+
+    A chamber at the supply pressure stays open to the pump; one below it is regulated to its
+    pressure (REGULATE), so at the vent command every chamber of the side is at the pressure
+    it was commanded, the denominator of Eq. (3.4).
+    """
     p = config.actuator
     pressures = side_pressures(config.side_deg, config.gauge)
-    events = []
+    events: list = []
     for i in range(CHAMBERS):
         if pressures[i] <= 0:
             continue
-        t_open = fill_time(p, pressures[i])
-        events.append((0.0, i, FILL))
-        if t_open < config.hold:  # otherwise still filling when it vents
-            events.append((t_open, i, HOLD))
+        if pressures[i] >= p.supply * (1 - 1e-9):
+            events.append((0.0, i, FILL))
+        else:
+            events.append((0.0, i, REGULATE, float(pressures[i])))
         events.append((config.hold, i, VENT))
     return ValveSchedule.build(events + config.damping.events(p, pressures, config.hold))
 
@@ -129,10 +139,16 @@ def oscillation_metrics(
 
 
 def run_metrics(run: Deactuation, band_deg: float) -> dict[str, float]:
-    """Metrics on the sensor (as the book measured) and on the true angle."""
+    """Metrics on the sensor (as the book measured) and on the true angle.
+
+    Settling times are sample instants, rounded to 1 µs to drop float noise (0.93, not
+    0.9300000000000002).
+    """
     band = np.radians(band_deg)
     sensed = oscillation_metrics(run.sensor_t, run.sensor_bend @ run.direction, run.t_off, band)
     true = oscillation_metrics(run.sim.t, run.sim.beta @ run.direction, run.t_off, band)
+    for m in (sensed, true):
+        m["settling"] = round(m["settling"], 6)  # nan stays nan
     return {
         "peak_deg": float(np.degrees(sensed["peak"])),
         "overshoot_pct": 100 * sensed["overshoot"],

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 from scipy.optimize import brentq
 
+from articula.errors import ModelError
 from articula.experiments.ch3 import DeactuationConfig, run_metrics, simulate
 from articula.plants.orientation_sensor import OrientationSensorParams
 from articula.plants.six_chamber import SixChamberParams
@@ -48,12 +49,19 @@ def calibrate(
 
     def modulus_for(b: float) -> float:
         return brentq(lambda E: undamped(with_(E, b))["peak_true_deg"] - peak_deg,
-                      1e4, 2e5, xtol=1.0)  # fmt: skip
+                      8e3, 2e5, xtol=1.0)  # fmt: skip
 
-    lo, hi = 1e-4, 5e-3  # b [N·m·s/rad]: settles too slowly at lo, too fast at hi
+    lo, hi = 1e-4, 4e-3  # b [N·m·s/rad]: settles too slowly at lo, too fast at hi
+    for b, slow in ((lo, True), (hi, False)):
+        settling = undamped(with_(modulus_for(b), b))["settling_true_s"]
+        if (not settling <= settling_s) != slow:  # nan: never settles, too slow
+            raise ModelError(
+                f"b = {b:g} N·m·s/rad settles in {settling:.3f} s, on the wrong side of "
+                f"{settling_s} s: the bracket [{lo:g}, {hi:g}] does not contain the fit"
+            )
     for _ in range(30):
         mid = (lo * hi) ** 0.5
-        if undamped(with_(modulus_for(mid), mid))["settling_true_s"] > settling_s:
+        if not undamped(with_(modulus_for(mid), mid))["settling_true_s"] <= settling_s:
             lo = mid
         else:
             hi = mid

@@ -3,8 +3,9 @@
 The body obeys V E k² θ + b θ' + I θ'' = V E c P (Sect. 3.2.2) about two bending axes. The
 bending vector β = θ·(cos ψ, sin ψ) [rad] points where the top surface tilts to. Chamber i sits
 at angle 60°·i on a circle of radius r_p; its volume grows as the body bends away from it,
-V_i = V_0 + a_i·β with a_i = −A_c r_p ê_i, and its gauge pressure pushes with the generalised
-force (p_i − p_atm)·a_i, which is the book's V E c P with V E c = A_c r_p.
+V_i = V_0 + a_i·β with a_i = −A_c r_p (L_c/L) ê_i (under constant curvature a chamber of length
+L_c in a body of length L turns through θ L_c/L), and its gauge pressure pushes with the
+generalised force (p_i − p_atm)·a_i, which is the book's V E c P with V E c = A_c r_p L_c/L.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from typing import Annotated
 import numpy as np
 from pydantic import Field, model_validator
 
-from articula.validation import StrictModel
+from articula.validation import StrictModel, field_error
 
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
@@ -44,8 +45,8 @@ class SixChamberParams(StrictModel):
     chamber_length: Positive = 0.09  # [m]
     density: Positive = 1080.0  # [kg/m³]
     sensor_mass: NonNegative = 0.02  # [kg] orientation sensor and its radio on the top
-    youngs_modulus: Positive = 19_670.0  # E [Pa], calibrated
-    damping: NonNegative = 1.937e-3  # b [N·m·s/rad], calibrated
+    youngs_modulus: Positive = 17_390.0  # E [Pa], calibrated
+    damping: NonNegative = 2.162e-3  # b [N·m·s/rad], calibrated
     supply: Positive = 100e3  # [Pa] gauge
     atmosphere: Positive = 101_325.0  # [Pa] absolute
     temperature: Positive = 293.15  # [K]
@@ -58,18 +59,22 @@ class SixChamberParams(StrictModel):
     @model_validator(mode="after")
     def _chambers_fit(self) -> SixChamberParams:
         if self.chamber_circle + self.chamber_radius >= self.outer_radius:
-            raise ValueError(
+            raise field_error(
+                "chamber_circle",
                 f"chamber_circle + chamber_radius ({self.chamber_circle} + "
-                f"{self.chamber_radius} m) must lie inside outer_radius ({self.outer_radius} m)"
+                f"{self.chamber_radius} m) must lie inside outer_radius ({self.outer_radius} m)",
             )
         if 2 * self.chamber_radius >= self.chamber_circle:  # neighbours are r_p apart
-            raise ValueError(
+            raise field_error(
+                "chamber_circle",
                 f"neighbouring chambers overlap: chamber_circle ({self.chamber_circle} m) must "
-                f"exceed twice chamber_radius ({self.chamber_radius} m)"
+                f"exceed twice chamber_radius ({self.chamber_radius} m)",
             )
         if self.chamber_length > self.length:
-            raise ValueError(
-                f"chamber_length ({self.chamber_length} m) must not exceed length ({self.length} m)"
+            raise field_error(
+                "chamber_length",
+                f"chamber_length ({self.chamber_length} m) must not exceed length "
+                f"({self.length} m)",
             )
         return self
 
@@ -109,8 +114,12 @@ class SixChamberParams(StrictModel):
 
     @property
     def lever(self) -> float:
-        """A_c r_p [m³/rad]: V E c of Sect. 3.2.2, and the chamber volume gained per radian."""
-        return self.chamber_area * self.chamber_circle
+        """A_c r_p L_c/L [m³/rad]: V E c of Sect. 3.2.2, and the chamber volume gained per radian.
+
+        Under constant curvature the chamber (length L_c) turns through θ L_c/L of the top's θ,
+        so its length grows by r_p θ L_c/L.
+        """
+        return self.chamber_area * self.chamber_circle * self.chamber_length / self.length
 
     @property
     def strain_per_pressure(self) -> float:

@@ -3,7 +3,10 @@
 State: β (2) [rad], β' (2) [rad/s] and the six absolute chamber pressures [Pa]. Each chamber's
 air obeys dp/dt = n/V (R T ṁ − p dV/dt) with V = V_0 + a_i·β, so a closed (holding) chamber is
 a gas spring, and flow through the valve orifice (to or from the pump or the atmosphere) is
-where the air loses energy. Valves change position only at scheduled events.
+where the air loses energy. Valves change position only at scheduled events, except in
+REGULATE, where the firmware holds a chamber at a target pressure by bang-bang on its 3/3
+valve: fill while the chamber is below the target, vent while it is above (a bending body
+compresses and expands a held chamber, so holding alone would let its pressure drift).
 """
 
 from __future__ import annotations
@@ -18,33 +21,58 @@ from articula.errors import ConfigError
 from articula.plants.six_chamber import CHAMBERS, GAS_CONSTANT, SixChamberParams, volume_gradients
 
 VENT, HOLD, FILL = 0, 1, 2  # the three positions of each 3-port 3-position valve
+REGULATE = 3  # firmware mode: FILL below the event's target pressure, VENT above it
+# (time [s], chamber, mode) or (time [s], chamber, REGULATE, target gauge pressure [Pa])
+Event = tuple[float, int, int] | tuple[float, int, int, float]
 
 
 @dataclass(frozen=True)
 class ValveSchedule:
-    """Valve commands: at times[k] [s] chamber chambers[k] goes to position modes[k]."""
+    """Valve commands: at times[k] [s] chamber chambers[k] goes to position modes[k].
+
+    targets[k] [Pa, gauge] is the pressure a REGULATE event holds (unused by other modes).
+    """
 
     times: np.ndarray
     chambers: np.ndarray
     modes: np.ndarray
+    targets: np.ndarray
 
     @staticmethod
-    def build(events: list[tuple[float, int, int]]) -> ValveSchedule:
-        """A schedule from (time [s], chamber, mode) tuples, sorted by time (stable)."""
-        for t, chamber, mode in events:
-            if not (0 <= chamber < CHAMBERS) or mode not in (VENT, HOLD, FILL):
-                raise ConfigError("valve", f"bad event (t={t}, chamber={chamber}, mode={mode})")
-        ordered = sorted(events, key=lambda e: e[0])
+    def build(
+        events: list[tuple[float, int, int] | tuple[float, int, int, float]],
+    ) -> ValveSchedule:
+        """A schedule from (time [s], chamber, mode[, target gauge Pa]) tuples, sorted by time
+        (stable); REGULATE events need a target above 0."""
+        full = [(*e, 0.0) if len(e) == 3 else tuple(e) for e in events]
+        for k, (t, chamber, mode, target) in enumerate(full):
+            if not (0 <= chamber < CHAMBERS):
+                raise ConfigError(
+                    f"events[{k}].chamber", f"must be 0-{CHAMBERS - 1} (got {chamber}, t = {t} s)"
+                )
+            if mode not in (VENT, HOLD, FILL, REGULATE):
+                raise ConfigError(
+                    f"events[{k}].mode",
+                    f"must be VENT {VENT}, HOLD {HOLD}, FILL {FILL} or REGULATE {REGULATE} "
+                    f"(got {mode}, t = {t} s)",
+                )
+            if mode == REGULATE and not (target > 0 and math.isfinite(target)):
+                raise ConfigError(
+                    f"events[{k}].target", f"REGULATE needs a gauge target > 0 Pa (got {target})"
+                )
+        ordered = sorted(full, key=lambda e: e[0])
         return ValveSchedule(
             np.array([e[0] for e in ordered], dtype=float),
             np.array([e[1] for e in ordered], dtype=np.int64),
             np.array([e[2] for e in ordered], dtype=np.int64),
+            np.array([e[3] for e in ordered], dtype=float),
         )
 
 
 @dataclass(frozen=True)
 class Simulation:
-    """Recorded samples: t [s], β (n, 2) [rad], gauge pressures (n, 6) [Pa], valve modes."""
+    """Recorded samples: t [s], β (n, 2) [rad], rate β' (n, 2) [rad/s], gauge pressures
+    (n, 6) [Pa] and valve modes (n, 6) (VENT, HOLD, FILL or REGULATE)."""
 
     t: np.ndarray
     beta: np.ndarray
@@ -72,15 +100,29 @@ def simulate(
     rate0: tuple[float, float] = (0.0, 0.0),
     modes0: np.ndarray | None = None,
 ) -> Simulation:
-    """Integrate from rest at atmospheric pressure (or β0, β'0) by RK4 with step dt [s]."""
-    if not (0 < dt <= 1e-3) or duration <= 0 or record_every < 1:
-        raise ConfigError("dt", f"need 0 < dt <= 1 ms and duration > 0 (got {dt}, {duration})")
+    """Integrate from rest at atmospheric pressure (or β0, β'0) by RK4 with step dt [s].
+
+    duration [s] > 0; every record_every-th step is kept; modes0 (6,) are the valves' initial
+    positions (VENT, HOLD or FILL; all VENT by default).
+    """
+    if not (0 < dt <= 1e-3):
+        raise ConfigError("dt", f"need 0 < dt <= 1e-3 s (got {dt})")
+    if not (duration > 0 and math.isfinite(duration)):
+        raise ConfigError("duration", f"need a finite duration > 0 s (got {duration})")
+    if record_every < 1:
+        raise ConfigError("record_every", f"need an integer >= 1 (got {record_every})")
     steps = round(duration / dt)
     modes = np.full(CHAMBERS, VENT, np.int64) if modes0 is None else np.array(modes0, np.int64)
+    if modes.shape != (CHAMBERS,) or not np.isin(modes, (VENT, HOLD, FILL)).all():
+        raise ConfigError(
+            "modes0",
+            f"need {CHAMBERS} valve positions, each VENT {VENT}, HOLD {HOLD} or FILL {FILL} "
+            f"(got {modes0!r})",
+        )
     y0 = np.concatenate([beta0, rate0, np.full(CHAMBERS, p.atmosphere)])
     t, y, m = _integrate(
         y0, modes, _constants(p), volume_gradients(p), schedule.times, schedule.chambers,
-        schedule.modes, dt, steps, record_every,
+        schedule.modes, schedule.targets + p.atmosphere, dt, steps, record_every,
     )  # fmt: skip
     return Simulation(t, y[:, 0:2], y[:, 2:4], y[:, 4:] - p.atmosphere, m)
 
@@ -94,7 +136,9 @@ def orifice_flow(upstream: float, downstream: float, rt: float, cda: float, tran
 
 
 @njit(cache=True, error_model="numpy")
-def _rhs(y: np.ndarray, modes: np.ndarray, c: np.ndarray, a: np.ndarray) -> np.ndarray:
+def _rhs(
+    y: np.ndarray, modes: np.ndarray, targets: np.ndarray, c: np.ndarray, a: np.ndarray
+) -> np.ndarray:
     inertia, stiff, damp, v0, n, rt, cda, trans, p_atm, p_sup, per_pa = c
     dy = np.empty_like(y)
     inflated = 0.0
@@ -110,9 +154,9 @@ def _rhs(y: np.ndarray, modes: np.ndarray, c: np.ndarray, a: np.ndarray) -> np.n
         ty += gauge * a[i, 1]
         volume = v0 + a[i, 0] * y[0] + a[i, 1] * y[1]
         dvol = a[i, 0] * y[2] + a[i, 1] * y[3]
-        if modes[i] == 2:
+        if modes[i] == FILL or (modes[i] == REGULATE and p < targets[i]):
             mdot = orifice_flow(p_sup, p, rt, cda, trans)
-        elif modes[i] == 0:
+        elif modes[i] == VENT or (modes[i] == REGULATE and p > targets[i]):
             mdot = orifice_flow(p_atm, p, rt, cda, trans)
         else:
             mdot = 0.0
@@ -127,12 +171,13 @@ def _rhs(y: np.ndarray, modes: np.ndarray, c: np.ndarray, a: np.ndarray) -> np.n
 @njit(cache=True, error_model="numpy")
 def _integrate(
     y0: np.ndarray, modes: np.ndarray, c: np.ndarray, a: np.ndarray, ev_t: np.ndarray,
-    ev_c: np.ndarray, ev_m: np.ndarray, dt: float, steps: int, every: int,
+    ev_c: np.ndarray, ev_m: np.ndarray, ev_p: np.ndarray, dt: float, steps: int, every: int,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
     n_rec = steps // every + 1
     ts = np.empty(n_rec)
     ys = np.empty((n_rec, y0.size))
     ms = np.empty((n_rec, 6), np.int64)
+    targets = np.zeros(6)  # absolute [Pa] of each chamber's REGULATE target
     y = y0.copy()
     k = 0
     rec = 0
@@ -140,6 +185,7 @@ def _integrate(
         t = step * dt
         while k < ev_t.size and ev_t[k] <= t + 0.5 * dt:
             modes[ev_c[k]] = ev_m[k]
+            targets[ev_c[k]] = ev_p[k]
             k += 1
         if step % every == 0:
             ts[rec] = t
@@ -148,10 +194,10 @@ def _integrate(
             rec += 1
         if step == steps:
             break
-        k1 = _rhs(y, modes, c, a)
-        k2 = _rhs(y + 0.5 * dt * k1, modes, c, a)
-        k3 = _rhs(y + 0.5 * dt * k2, modes, c, a)
-        k4 = _rhs(y + dt * k3, modes, c, a)
+        k1 = _rhs(y, modes, targets, c, a)
+        k2 = _rhs(y + 0.5 * dt * k1, modes, targets, c, a)
+        k3 = _rhs(y + 0.5 * dt * k2, modes, targets, c, a)
+        k4 = _rhs(y + dt * k3, modes, targets, c, a)
         y = y + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
     return ts[:rec], ys[:rec], ms[:rec]
 
