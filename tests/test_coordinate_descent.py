@@ -61,9 +61,36 @@ def test_bounds_are_never_evaluated_outside():
 
 
 @pytest.mark.parametrize(
-    ("k0", "dk0", "field"),
-    [([0.0, 1.0], [0.1], "dk0"), ([0.0], [-0.1], "dk0"), ([np.nan], [0.1], "dk0")],
+    ("kwargs", "field"),
+    [
+        ({"k0": [0.0, 1.0], "dk0": [0.1]}, "dk0"),
+        ({"dk0": [-0.1, 0.1]}, "dk0"),
+        ({"dk0": [np.inf, 0.1]}, "dk0"),
+        ({"k0": [np.nan, 0.0]}, "k0"),
+        ({"k0": [[0.0, 0.0]], "dk0": [[0.1, 0.1]]}, "k0"),
+        ({"k_stop": np.nan}, "k_stop"),
+        ({"k_stop": -1.0}, "k_stop"),
+        ({"max_iterations": 0}, "max_iterations"),
+        ({"max_iterations": 2.5}, "max_iterations"),
+        ({"lower": np.zeros(3)}, "lower"),
+        ({"upper": np.ones((2, 1))}, "upper"),
+        ({"lower": np.ones(2), "upper": np.zeros(2)}, "upper"),
+        ({"k0": [5.0, 0.0], "upper": np.ones(2)}, "k0"),
+    ],
 )
-def test_bad_start_is_a_config_error(k0, dk0, field):
-    with pytest.raises(ConfigError, match=field):
-        coordinate_descent(lambda k: 0.0, np.array(k0), np.array(dk0), 0.0, 1)
+def test_bad_arguments_are_config_errors_naming_the_field(kwargs, field):
+    args = {"k0": [0.0, 0.0], "dk0": [0.1, 0.1], "k_stop": 0.0, "max_iterations": 1, **kwargs}
+    args["k0"], args["dk0"] = np.array(args["k0"]), np.array(args["dk0"])
+    with pytest.raises(ConfigError) as exc:
+        coordinate_descent(lambda k: 0.0, **args)
+    assert exc.value.field == field, exc.value
+
+
+def test_history_is_read_only_and_keeps_the_start():
+    k0 = np.array([0.0, 1.0])
+    res = coordinate_descent(lambda k: float(k @ k), k0, np.array([0.5, 0.5]), 0.0, 3)
+    k0[0] = 99.0  # the caller's array is copied
+    assert res.history[0].k.tolist() == [0.0, 1.0]
+    for array in (res.k, res.history[-1].k, res.history[-1].dk):
+        with pytest.raises(ValueError):
+            array[0] = 1.0

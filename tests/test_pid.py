@@ -126,3 +126,14 @@ def test_bad_pid_arguments_name_the_field():
     with pytest.raises(ConfigError) as exc:
         pid(1.0, 0.0, np.zeros(1))
     assert exc.value.field == "t"
+
+
+def test_schedule_holds_read_only_copies():
+    rows = ROWS.copy()
+    s = GainSchedule("fuzzy", rows, POINTS)
+    rows[0, 0] = 99.0  # the caller's array is copied
+    assert s(15.0)[0] == 1.0
+    with pytest.raises(ValueError):
+        s.gains[0, 0] = 5.0
+    with pytest.raises(ValueError):
+        s.points[0] = 5.0

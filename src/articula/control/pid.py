@@ -19,7 +19,7 @@ from articula.errors import ConfigError
 ScheduleKind = Literal["constant", "piecewise", "fuzzy"]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class GainSchedule:
     """K(θ_r) of Eq. (2.4): rows [K_p, K_i, K_d] at representative points of θ_r.
 
@@ -28,6 +28,7 @@ class GainSchedule:
     on the left ([0, 30), [30, 60), [60, 90] for points 15, 45, 75). fuzzy: linear between
     neighbouring points and constant beyond the outer ones, so continuous everywhere.
     Points and θ_r share one unit (degrees in chapter 2, as the book's gains are per degree).
+    Gains and points are stored as read-only copies.
     """
 
     kind: ScheduleKind
@@ -35,8 +36,10 @@ class GainSchedule:
     points: np.ndarray = field(default_factory=lambda: np.zeros(1))  # (rows,)
 
     def __post_init__(self) -> None:
-        gains = np.atleast_2d(np.asarray(self.gains, dtype=float))
-        points = np.atleast_1d(np.asarray(self.points, dtype=float))
+        gains = np.atleast_2d(np.array(self.gains, dtype=float))
+        points = np.atleast_1d(np.array(self.points, dtype=float))
+        gains.setflags(write=False)
+        points.setflags(write=False)
         object.__setattr__(self, "gains", gains)
         object.__setattr__(self, "points", points)
         if gains.ndim != 2 or gains.shape[1] != 3 or not np.all(np.isfinite(gains)):

@@ -19,7 +19,7 @@ from articula.control.pid import PID, GainSchedule
 from articula.experiments.registry import Result, register
 from articula.plants.pneunet import PneuNetBatch, PneuNetParams
 from articula.tuning.response import Response, tracking_error, tuning_cost
-from articula.validation import StrictModel
+from articula.validation import StrictModel, field_error
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
@@ -46,9 +46,10 @@ class ReferenceConfig(StrictModel):
     def _inside_range(self) -> ReferenceConfig:
         lo, hi = self.offset_deg - self.amplitude_deg, self.offset_deg + self.amplitude_deg
         if self.kind == "sinusoid" and (lo < 0 or hi > 90):
-            raise ValueError(
+            raise field_error(
+                "amplitude_deg",
                 f"the sinusoid spans {lo:g}-{hi:g}°, outside the book's 0-90°; "
-                "lower amplitude_deg or move offset_deg"
+                "lower amplitude_deg or move offset_deg",
             )
         return self
 
@@ -71,16 +72,17 @@ class ControllerConfig(StrictModel):
     def _rows_match(self) -> ControllerConfig:
         rows = len(self.gains)
         if self.schedule == "constant" and rows != 1:
-            raise ValueError(f"a constant schedule takes one row of gains (got {rows})")
+            raise field_error("gains", f"a constant schedule takes one row of gains (got {rows})")
         if self.schedule != "constant" and rows != len(self.points_deg):
-            raise ValueError(
+            raise field_error(
+                "gains",
                 f"{self.schedule} needs one row of gains per point of points_deg "
-                f"({len(self.points_deg)}), got {rows}"
+                f"({len(self.points_deg)}), got {rows}",
             )
         if self.schedule != "constant" and any(
             b <= a for a, b in zip(self.points_deg, self.points_deg[1:], strict=False)
         ):
-            raise ValueError(f"points_deg must increase (got {self.points_deg})")
+            raise field_error("points_deg", f"must increase (got {self.points_deg})")
         return self
 
     def build(self, trials: int) -> PID:
@@ -104,19 +106,25 @@ class PneuNetPidConfig(StrictModel):
     def _check_times(self) -> PneuNetPidConfig:
         steps = self.duration / self.plant.pwm_period
         if steps > MAX_STEPS:
-            raise ValueError(f"duration/pwm_period is over {MAX_STEPS} steps; shorten duration")
+            raise field_error(
+                "duration", f"duration/pwm_period is over {MAX_STEPS} steps; shorten duration"
+            )
         if steps * self.trials > MAX_SAMPLES:
-            raise ValueError(
+            raise field_error(
+                "trials",
                 f"trials × steps is over {MAX_SAMPLES}; run fewer trials per config (a sweep "
-                "over seed splits them)"
+                "over seed splits them)",
             )
         if self.settle >= self.duration - 2 * self.plant.pwm_period:
-            raise ValueError(
-                f"settle ({self.settle} s) leaves fewer than two samples of duration "
-                f"({self.duration} s); shorten settle"
+            raise field_error(
+                "settle",
+                f"{self.settle} s leaves fewer than two samples of duration "
+                f"({self.duration} s); shorten settle",
             )
         if self.duration < len(self.reference.levels_deg) * self.plant.pwm_period:
-            raise ValueError("duration is shorter than one sample per level of the reference")
+            raise field_error(
+                "duration", "shorter than one sample per level of the reference; lengthen it"
+            )
         return self
 
     @property
@@ -125,9 +133,12 @@ class PneuNetPidConfig(StrictModel):
         return round(self.duration / self.plant.pwm_period)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class ClosedLoopTrace:
-    """Times [s] (n,), reference [°] (n,); measured, true angle [°] and duty, (trials, n)."""
+    """Times [s] (n,), reference [°] (n,); measured, true angle [°] and duty, (trials, n).
+
+    The arrays are read-only.
+    """
 
     t: np.ndarray
     reference: np.ndarray
@@ -137,7 +148,7 @@ class ClosedLoopTrace:
 
 
 def reference_deg(reference: ReferenceConfig, t: np.ndarray) -> np.ndarray:
-    """θ_r at the sample times [°]."""
+    """θ_r at the sample times [°]; steps: the levels in order, each for an equal share of t."""
     if reference.kind == "sinusoid":
         phase = 2 * math.pi * reference.frequency * t
         return reference.offset_deg - reference.amplitude_deg * np.cos(phase)
@@ -158,15 +169,19 @@ def run_closed_loop(
     vary: scale each trial's actuator by its own draw of PneuNetParams.trial_factors; False
     keeps the nominal actuator for every trial (only the sensor noise differs).
 
-    Trial i draws its sensor noise, then its plant variation, from
-    numpy.random.default_rng(seeds[i]) alone, so a trial gives the same numbers alone or in a
-    batch.
+    Trial i splits numpy.random.SeedSequence(seeds[i]) into two streams: the first draws its
+    sensor noise, the second its actuator variation. So a trial gives the same numbers alone or
+    in a batch, and trial i is the same actuator whatever the run's length (or frequency).
     """
     steps = reference.size
     trials = len(seeds)
-    rngs = [np.random.default_rng(s) for s in seeds]
-    noise = np.stack([rng.standard_normal(steps) for rng in rngs])
-    factors = np.stack([params.trial_factors(rng) for rng in rngs]) if vary else None
+    streams = [np.random.SeedSequence(s).spawn(2) for s in seeds]
+    noise = np.stack([np.random.default_rng(n).standard_normal(steps) for n, _ in streams])
+    factors = (
+        np.stack([params.trial_factors(np.random.default_rng(a)) for _, a in streams])
+        if vary
+        else None
+    )
     plant = PneuNetBatch(params, trials, factors)
     controller.reset(trials)
     full_scale = controller.output_limits[1]
@@ -178,6 +193,9 @@ def run_closed_loop(
         u = controller(t[n], reference[n], measured[:, n])
         duty[:, n] = np.floor(u) / full_scale  # analogWrite takes an integer count
         plant.advance(duty[:, n])
+    reference = np.array(reference, dtype=float)  # the trace keeps its own copy
+    for array in (t, reference, measured, theta, duty):
+        array.setflags(write=False)
     return ClosedLoopTrace(t, reference, measured, theta, duty)
 
 

@@ -13,11 +13,16 @@ import numpy as np
 from pydantic import Field
 
 from articula.control.pid import PID, GainSchedule
-from articula.experiments.ch2 import SimulatedRig, run_closed_loop
+from articula.experiments.ch2 import (
+    ReferenceConfig,
+    SimulatedRig,
+    reference_deg,
+    run_closed_loop,
+)
 from articula.plants.pneunet import PneuNetParams
 from articula.tuning.coordinate_descent import DescentResult, coordinate_descent
 from articula.tuning.manual import ManualResult, ManualSettings, manual_tuning
-from articula.tuning.response import tuning_cost
+from articula.tuning.response import Response, readonly, step_features, tuning_cost
 from articula.validation import StrictModel
 
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
@@ -64,9 +69,10 @@ class TuningRun:
 
 
 def step_reference(levels: tuple[float, ...], hold: float, period: float) -> np.ndarray:
-    """Levels [°] held `hold` seconds each, sampled every PWM period."""
-    per_level = round(hold / period)
-    return np.repeat(np.asarray(levels, dtype=float), per_level)
+    """Levels [°] held `hold` seconds each, sampled every PWM period (reference_deg, steps)."""
+    steps = len(levels) * round(hold / period)
+    config = ReferenceConfig(kind="steps", levels_deg=[float(v) for v in levels])
+    return reference_deg(config, np.arange(steps) * period)
 
 
 def manual_run(config: TuningConfig, level: float) -> ManualResult:
@@ -97,20 +103,57 @@ def auto_run(config: TuningConfig, levels: tuple[float, ...], index: int) -> Tun
     return TuningRun(levels, result)
 
 
+@dataclass(frozen=True, eq=False)
+class KdProbe:
+    """Paired experiments of one gain set with its K_d replaced by each value of `kd`.
+
+    cost: M (2.5) per K_d and experiment, (len(kd), n). swings: swings of the sensor reading
+    beyond the noise band about each level, summed over the levels, (len(kd), n).
+    sustained: whether some level's swings do not die out (StepFeatures.sustained), same
+    shape. Arrays are read-only.
+    """
+
+    kd: tuple[float, ...]
+    cost: np.ndarray
+    swings: np.ndarray
+    sustained: np.ndarray
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "cost", readonly(self.cost))
+        object.__setattr__(self, "swings", readonly(self.swings))
+        sustained = np.array(self.sustained, dtype=bool)
+        sustained.setflags(write=False)
+        object.__setattr__(self, "sustained", sustained)
+
+
 def kd_probe(
     plant: PneuNetParams, gains: np.ndarray, levels: tuple[float, ...], hold: float,
-    kd_values: tuple[float, ...], seeds: int,
-) -> dict[float, np.ndarray]:  # fmt: skip
-    """M (2.5) of `seeds` experiments for the gains with K_d replaced by each value.
+    kd_values: tuple[float, ...], seeds: int, band: float,
+) -> KdProbe:  # fmt: skip
+    """M (2.5) and swings of `seeds` step experiments for the gains with K_d set to each value.
 
     Every K_d sees the same noise seeds, so differences between K_d values are paired; the
-    experiments run as one batch, which gives the numbers of running them one by one.
+    experiments run as one batch, which gives the numbers of running them one by one. `band`
+    [°] is the noise band of the swing count.
     """
     reference = step_reference(levels, hold, plant.pwm_period)
-    seeds = range(50_000, 50_000 + seeds)
-    costs = {}
+    per_level = reference.size // len(levels)
+    seeds_used = range(50_000, 50_000 + seeds)
+    cost, swings, sustained = [], [], []
     for kd in kd_values:
         schedule = GainSchedule("constant", np.array([[gains[0], gains[1], kd]]))
-        trace = run_closed_loop(plant, PID(schedule, (0.0, 255.0)), reference, seeds, vary=False)
-        costs[kd] = tuning_cost(trace.t, trace.reference, trace.measured)
-    return costs
+        pid = PID(schedule, (0.0, 255.0))
+        trace = run_closed_loop(plant, pid, reference, seeds_used, vary=False)
+        cost.append(tuning_cost(trace.t, trace.reference, trace.measured))
+        count = np.zeros(seeds, dtype=int)
+        lasting = np.zeros(seeds, dtype=bool)
+        for j in range(len(levels)):
+            part = slice(j * per_level, (j + 1) * per_level)
+            for i in range(seeds):
+                r = Response(trace.t[part], trace.reference[part], trace.measured[i, part])
+                f = step_features(r, band)
+                count[i] += f.peak_sizes.size
+                lasting[i] |= f.sustained()
+        swings.append(count)
+        sustained.append(lasting)
+    return KdProbe(tuple(kd_values), np.array(cost), np.array(swings), np.array(sustained))

@@ -19,7 +19,8 @@ import numpy as np
 from pydantic import Field, model_validator
 from scipy.linalg import expm
 
-from articula.validation import StrictModel
+from articula.errors import ConfigError
+from articula.validation import StrictModel, field_error
 
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
@@ -59,16 +60,13 @@ class PneuNetParams(StrictModel):
 
     @model_validator(mode="after")
     def _check(self) -> PneuNetParams:
-        if 0.5 * self.chamber_tau <= self.valve_tau <= 1.5 * self.chamber_tau:
-            raise ValueError(
-                "valve_tau must lie outside chamber_tau × [0.5, 1.5] (the exact update divides "
-                "by τ_v − τ_p, and trials scale τ_p by up to ±50 %)"
-            )
         reach = self.theta_max * (1 - math.exp(-self.supply_pressure / self.pressure_scale))
         if reach <= math.radians(90.0):
-            raise ValueError(
-                f"full supply bends only {math.degrees(reach):.1f}°; the book's range is "
-                "0-90°, so raise supply_pressure or theta_max"
+            raise field_error(
+                "supply_pressure",
+                f"full supply ({self.supply_pressure:g} Pa) bends only "
+                f"{math.degrees(reach):.1f}°; the book's range is 0-90°, so raise "
+                "supply_pressure or theta_max",
             )
         return self
 
@@ -94,8 +92,16 @@ class PneuNetBatch:
     def __init__(
         self, params: PneuNetParams, trials: int, factors: np.ndarray | None = None
     ) -> None:
+        if isinstance(trials, bool) or not isinstance(trials, int | np.integer) or trials < 1:
+            raise ConfigError("trials", f"must be an integer >= 1 (got {trials!r})")
         self.params = params
         f = np.ones((trials, 3)) if factors is None else np.asarray(factors, dtype=float)
+        if f.shape != (trials, 3) or not np.all(np.isfinite(f)) or np.any(f <= 0):
+            raise ConfigError(
+                "factors",
+                f"need finite positive scales of shape ({trials}, 3) = (trials, [supply, "
+                f"chamber τ, reach]) (got shape {f.shape})",
+            )
         self.supply = params.supply_pressure * f[:, 0]
         self.chamber_tau = params.chamber_tau * f[:, 1]
         self.reach = f[:, 2]
@@ -132,17 +138,27 @@ class PneuNetBatch:
         self.omega = c * offset + d * self.omega
 
     def _linear_segment(self, command: float, duration: np.ndarray) -> None:
-        """Exact solution of τ_v x' = u − x, τ_p p' = P_s x − p over `duration` [s]."""
+        """Exact solution of τ_v x' = u − x, τ_p p' = P_s x − p over `duration` [s].
+
+        p(t) − P_s u = (p0 − P_s u) e_p + P_s x0 · τ_v/(τ_v − τ_p) · (e_v − e_p), with
+        e_v = exp(−t/τ_v), e_p = exp(−t/τ_p). The last term is written as
+        P_s x0 · (t/τ_p) · e_slow · φ(s), e_slow the slower of e_v and e_p,
+        s = −|1/τ_p − 1/τ_v|·t ≤ 0 and φ(s) = expm1(s)/s (φ(0) = 1): the same number
+        without the division by τ_v − τ_p, so τ_v = τ_p (the repeated pole, whose term is
+        P_s x0 (t/τ_p) e_p) and τ_v close to τ_p are exact too.
+        """
         p = self.params
         tv, tp, ps = p.valve_tau, self.chamber_tau, self.supply
-        ev = np.exp(-duration / tv)
-        ep = np.exp(-duration / tp)
+        t = duration
+        ev = np.exp(-t / tv)
+        ep = np.exp(-t / tp)
         x0 = self.valve - command
-        # p(t) − P_s u = (p0 − P_s u) e_p + P_s x0 · τ_v/(τ_v − τ_p) · (e_v − e_p)
+        slow = np.exp(-t / np.maximum(tv, tp))
+        s = -np.abs(1.0 / tp - 1.0 / tv) * t
+        phi = np.ones_like(s)
+        np.divide(np.expm1(s), s, out=phi, where=s != 0)
         self.pressure = (
-            ps * command
-            + (self.pressure - ps * command) * ep
-            + ps * x0 * tv / (tv - tp) * (ev - ep)
+            ps * command + (self.pressure - ps * command) * ep + ps * x0 * (t / tp) * slow * phi
         )
         self.valve = command + x0 * ev
 

@@ -8,13 +8,17 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from articula.errors import ConfigError
+from articula.tuning.response import readonly
 
 Cost = Callable[[np.ndarray], float]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class DescentStep:
-    """The state after one sweep over all coordinates (one `count` of Algorithm 1)."""
+    """The state after one sweep over all coordinates (one `count` of Algorithm 1).
+
+    k and dk are stored as read-only copies.
+    """
 
     count: int
     k: np.ndarray
@@ -22,15 +26,25 @@ class DescentStep:
     best_cost: float
     evaluations: int
 
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "k", readonly(self.k))
+        object.__setattr__(self, "dk", readonly(self.dk))
 
-@dataclass(frozen=True)
+
+@dataclass(frozen=True, eq=False)
 class DescentResult:
-    """Optimised parameters K*, their cost M(K*), and the history of every sweep."""
+    """Optimised parameters K* (read-only copy), their cost M(K*), and every sweep's state.
+
+    history[0] holds the random start, so history[0].k against k shows what moved.
+    """
 
     k: np.ndarray
     cost: float
     evaluations: int
     history: list[DescentStep] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "k", readonly(self.k))
 
 
 def coordinate_descent(
@@ -54,12 +68,29 @@ def coordinate_descent(
     """
     k = np.array(k0, dtype=float)
     dk = np.array(dk0, dtype=float)
-    if k.ndim != 1 or dk.shape != k.shape:
+    if k.ndim != 1 or k.size == 0 or not np.all(np.isfinite(k)):
+        raise ConfigError("k0", f"must be a finite non-empty 1-D vector (got {k.tolist()})")
+    if dk.shape != k.shape:
         raise ConfigError("dk0", f"must have the shape of k0 {k.shape} (got {dk.shape})")
-    if not (np.all(np.isfinite(k)) and np.all(np.isfinite(dk)) and np.all(dk > 0)):
-        raise ConfigError("dk0", "k0 must be finite and dk0 finite and positive")
-    lo = np.full(k.shape, -np.inf) if lower is None else np.asarray(lower, dtype=float)
-    hi = np.full(k.shape, np.inf) if upper is None else np.asarray(upper, dtype=float)
+    if not (np.all(np.isfinite(dk)) and np.all(dk > 0)):
+        raise ConfigError("dk0", f"must be finite and positive (got {dk.tolist()})")
+    if isinstance(k_stop, bool) or not (np.isfinite(k_stop) and k_stop >= 0):
+        raise ConfigError("k_stop", f"must be finite and >= 0 (got {k_stop!r})")
+    if (
+        isinstance(max_iterations, bool)
+        or not isinstance(max_iterations, int | np.integer)
+        or max_iterations < 1
+    ):
+        raise ConfigError("max_iterations", f"must be an integer >= 1 (got {max_iterations!r})")
+    lo = np.full(k.shape, -np.inf) if lower is None else np.array(lower, dtype=float)
+    hi = np.full(k.shape, np.inf) if upper is None else np.array(upper, dtype=float)
+    for name, bound in (("lower", lo), ("upper", hi)):
+        if bound.shape != k.shape or np.any(np.isnan(bound)):
+            raise ConfigError(
+                name, f"must be a vector of the shape of k0 {k.shape}, no NaN (got {bound.shape})"
+            )
+    if np.any(lo > hi):
+        raise ConfigError("upper", f"must be >= lower (got {hi.tolist()} < {lo.tolist()})")
     if np.any(k < lo) or np.any(k > hi):
         raise ConfigError("k0", f"must lie within the bounds (got {k.tolist()})")
     evaluations = 1

@@ -14,7 +14,13 @@ from typing import Literal
 import numpy as np
 
 from articula.errors import ConfigError, InfeasibleError
-from articula.tuning.response import Experiment, Response, StepFeatures, step_features
+from articula.tuning.response import (
+    Experiment,
+    Response,
+    StepFeatures,
+    readonly,
+    step_features,
+)
 
 
 @dataclass(frozen=True)
@@ -35,22 +41,34 @@ class Ladder:
         return [self.start * self.factor**i for i in range(count)]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Trial:
-    """One experiment of a tuning procedure: gains, response, features and what was decided."""
+    """One experiment of a tuning procedure: gains (read-only copy), response, features and
+    what was decided."""
 
     gains: np.ndarray
     response: Response
     features: StepFeatures
     decision: str
 
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "gains", readonly(self.gains))
 
-@dataclass(frozen=True)
+
+@dataclass(frozen=True, eq=False)
 class ManualResult:
-    """Chosen gains [K_p, K_i, K_d] and every experiment that led to them."""
+    """Chosen gains [K_p, K_i, K_d] (read-only copy) and every experiment that led to them.
+
+    within_tolerance: False when no K_i on the ladder brought the steady-state error within
+    the tolerance (the largest K_i tried is kept, and its trial says so).
+    """
 
     gains: np.ndarray
     trials: list[Trial] = field(default_factory=list)
+    within_tolerance: bool = True
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "gains", readonly(self.gains))
 
 
 @dataclass(frozen=True)
@@ -67,7 +85,14 @@ class ManualSettings:
 def manual_tuning(
     experiment: Experiment, settings: ManualSettings = ManualSettings()
 ) -> ManualResult:
-    """Sect. 2.3.2.1 scripted: K_p to converging swings, K_i to zero error, K_d for overshoot."""
+    """Sect. 2.3.2.1 scripted: K_p to converging swings, K_i to zero error, K_d for overshoot.
+
+    Every experiment is run once and kept with its decision. K_d is always tried at the first
+    rung of its ladder (at least one experiment with K_d > 0), and raised only while the step
+    response shows an overshoot lower by more than the noise band, no more swings and a
+    steady-state error still within tolerance. Raises InfeasibleError if the smallest K_p
+    already gives swings that grow or persist (the procedure has no K_p to keep).
+    """
     trials: list[Trial] = []
 
     def run(gains: list[float]) -> StepFeatures:
@@ -76,38 +101,52 @@ def manual_tuning(
         trials.append(Trial(np.array(gains), response, features, ""))
         return features
 
-    def decide(text: str) -> None:
-        last = trials[-1]
-        trials[-1] = Trial(last.gains, last.response, last.features, text)
+    def decide(index: int, text: str, replace: bool = False) -> None:
+        old = trials[index]
+        joined = f"{old.decision}; {text}" if old.decision and not replace else text
+        trials[index] = Trial(old.gains, old.response, old.features, joined)
 
-    kp = settings.kp.start
+    # K_p with K_i = K_d = 0, up the ladder until the swings converge.
+    kp, kept = 0.0, -1  # kept: index of the kept K_p's experiment
     for value in settings.kp.values():
         f = run([value, 0.0, 0.0])
         if f.oscillates and not f.converging:
-            decide("K_p: swings grow or persist; keep the previous K_p")
+            if kept < 0:
+                decide(-1, "K_p: swings grow or persist at the smallest rung")
+                raise InfeasibleError(
+                    f"kp.start: the smallest K_p ({value:g}) already gives swings that grow or "
+                    "persist; lower the K_p ladder's start"
+                )
+            decide(-1, "K_p: swings grow or persist; keep the previous K_p")
             break
-        kp = value
+        kp, kept = value, len(trials) - 1
         if f.converging:
-            decide("K_p: converging oscillation reached")
+            decide(-1, "K_p: converging oscillation reached")
             break
-        decide("K_p: no oscillation yet; raise K_p")
-    ki = 0.0
-    f = run([kp, 0.0, 0.0])
+        decide(-1, "K_p: no oscillation yet; raise K_p")
+    else:
+        decide(kept, "K_p: top of the ladder without converging swings; keep it", replace=True)
+    f = trials[kept].features  # the kept K_p's experiment: not run again
+    # K_i until the steady-state error is within tolerance.
+    ki, within = 0.0, True
     if f.steady_state_error > settings.tolerance:
-        decide("K_i: steady-state error; raise K_i")
+        decide(kept, "K_i: steady-state error; raise K_i")
+        within = False
         for value in settings.ki.values():
             ki = value
             f = run([kp, ki, 0.0])
+            kept = len(trials) - 1
             if f.steady_state_error <= settings.tolerance:
-                decide("K_i: steady-state error within tolerance")
+                decide(-1, "K_i: steady-state error within tolerance")
+                within = True
                 break
-            decide("K_i: steady-state error remains; raise K_i")
+            decide(-1, "K_i: steady-state error remains; raise K_i")
+        else:
+            decide(-1, "K_i: top of the ladder with the error above tolerance; keep this K_i")
     else:
-        decide("K_i: no steady-state error; K_i = 0")
+        decide(kept, "K_i: no steady-state error; K_i = 0")
+    # K_d: at least one rung, kept only while the step response improves.
     kd, best = 0.0, f
-    if best.overshoot <= settings.band:
-        decide(trials[-1].decision + "; no overshoot beyond the noise band, so K_d = 0")
-        return ManualResult(np.array([kp, ki, kd]), trials)
     for value in settings.kd.values():
         g = run([kp, ki, value])
         better = (
@@ -116,11 +155,16 @@ def manual_tuning(
             and g.steady_state_error <= max(settings.tolerance, best.steady_state_error)
         )
         if not better:
-            decide("K_d: more swings or no less overshoot; keep the previous K_d")
+            decide(
+                -1,
+                f"K_d: overshoot not lower by more than the band ({g.overshoot:.3g} vs "
+                f"{best.overshoot:.3g}), or more swings ({g.peak_sizes.size} vs "
+                f"{best.peak_sizes.size}), or more error; keep K_d = {kd:g}",
+            )
             break
-        decide("K_d: less overshoot; raise K_d")
+        decide(-1, "K_d: less overshoot; raise K_d")
         kd, best = value, g
-    return ManualResult(np.array([kp, ki, kd]), trials)
+    return ManualResult(np.array([kp, ki, kd]), trials, within)
 
 
 ZnRule = Literal["P", "PI", "PID"]
@@ -152,7 +196,7 @@ def ultimate_gain(
         gains = np.array([kp, 0.0, 0.0])
         response = experiment(gains)
         f = step_features(response, band)
-        hit = f.peak_sizes.size >= 3 and f.decay >= sustained
+        hit = f.sustained(sustained)
         trials.append(Trial(gains, response, f, "sustained" if hit else "decays or none"))
         if hit:
             return kp, f.period, trials

@@ -12,13 +12,27 @@ from dataclasses import dataclass
 import numpy as np
 
 
-@dataclass(frozen=True)
+def readonly(values: np.ndarray | float | list[float]) -> np.ndarray:
+    """A read-only float copy, for arrays held by frozen dataclasses."""
+    array = np.array(values, dtype=float)
+    array.setflags(write=False)
+    return array
+
+
+@dataclass(frozen=True, eq=False)
 class Response:
-    """Sample times [s], reference and measured output (same unit, e.g. degrees), all (n,)."""
+    """Sample times [s], reference and measured output (same unit, e.g. degrees), all (n,).
+
+    The arrays are stored as read-only copies.
+    """
 
     t: np.ndarray
     reference: np.ndarray
     measured: np.ndarray
+
+    def __post_init__(self) -> None:
+        for name in ("t", "reference", "measured"):
+            object.__setattr__(self, name, readonly(getattr(self, name)))
 
 
 Experiment = Callable[[np.ndarray], Response]
@@ -40,7 +54,7 @@ def tuning_cost(t: np.ndarray, reference: np.ndarray, measured: np.ndarray) -> n
     return np.mean(np.abs(e) + np.abs(slope), axis=-1)  # Eq. (2.5)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class StepFeatures:
     """What the manual procedure looks at in a step response from rest (response units)."""
 
@@ -48,6 +62,10 @@ class StepFeatures:
     steady_state_error: float  # |target − mean output| over the last quarter of the run
     peak_times: np.ndarray  # [s] extremes of each swing about the final level, beyond the band
     peak_sizes: np.ndarray  # |output − final level| at those extremes
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "peak_times", readonly(self.peak_times))
+        object.__setattr__(self, "peak_sizes", readonly(self.peak_sizes))
 
     @property
     def oscillates(self) -> bool:
@@ -63,6 +81,15 @@ class StepFeatures:
     def converging(self) -> bool:
         """Oscillating with swings that shrink."""
         return self.oscillates and self.decay < 1.0
+
+    def sustained(self, keep: float = 0.8) -> bool:
+        """At least three swings, the last two still `keep` of the first two's size or more.
+
+        Swings are compared in pairs (one up, one down) because a driven soft actuator swings
+        further one way than the other.
+        """
+        sizes = self.peak_sizes
+        return sizes.size >= 3 and float(np.mean(sizes[-2:])) >= keep * float(np.mean(sizes[:2]))
 
     @property
     def period(self) -> float:

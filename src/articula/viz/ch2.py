@@ -82,15 +82,28 @@ def error_summary(
     book: Mapping[str, Sequence[Sequence[float]]],
     path: Path,
 ) -> None:
-    """Fig. 2.10: median E with first and third quartiles against frequency, ours and book."""
+    """Fig. 2.10: median E with first and third quartiles against frequency, ours and book.
+
+    Rows are (median, Q1, Q3). Each bar is drawn from Q1 to Q3 as given, so an entry whose
+    quartiles do not bracket the median (the book's fuzzy-automatic 5 Hz Q3) shows as printed
+    and is circled and labelled as a probable misprint.
+    """
     fig, axes = plt.subplots(1, 2, figsize=(13, 4.5), sharey=True)
     f = np.asarray(frequencies)
     for ax, (label, data) in zip(axes, (("simulated PneuNet", ours), ("book", book)), strict=True):
         for i, (name, rows) in enumerate(data.items()):
             q = np.asarray(rows, dtype=float)
             shift = f * 1.04 ** (i - 2.5)  # spread the markers so the bars do not overlap
-            ax.errorbar(shift, q[:, 0], yerr=[q[:, 0] - q[:, 1], np.abs(q[:, 2] - q[:, 0])],
-                        marker="o", ms=3, capsize=2, lw=0.8, label=name)  # fmt: skip
+            (line,) = ax.plot(shift, q[:, 0], marker="o", ms=3, lw=0.8, label=name)
+            ax.vlines(shift, q[:, 1], q[:, 2], color=line.get_color(), lw=0.8)
+            ax.plot(shift, q[:, 1], "_", ms=5, color=line.get_color())
+            ax.plot(shift, q[:, 2], "_", ms=5, color=line.get_color())
+            odd = (q[:, 1] > q[:, 0]) | (q[:, 2] < q[:, 0])
+            for x, row in zip(shift[odd], q[odd], strict=True):
+                ax.plot(x, row[2], "o", ms=9, mfc="none", color="k", lw=0.8)
+                ax.annotate(f"{name}: Q1 {row[1]:g}, Q3 {row[2]:g}, median {row[0]:g} (misprint?)",
+                            (x, row[2]), xytext=(-150, -25), textcoords="offset points",
+                            fontsize=7, arrowprops={"arrowstyle": "-", "lw": 0.5})  # fmt: skip
         ax.set_xscale("log")
         ax.set_xlabel("reference frequency [Hz]")
         ax.set_title(f"E, Eq. (2.7): median (Q1, Q3), {label}")
