@@ -174,3 +174,24 @@ def test_every_run_names_a_packaged_scene():
         assert Path(path).is_file(), scene
         data = tomllib.loads(Path(path).read_text())
         assert data["planner"]["d_min"] > 0 and data["planner"]["lambda_weight"] > 0, scene
+
+
+def test_full_mode_comparison_averages_each_seed_once():
+    # Synthetic metrics: run k of a (scene, method) has rms_error k, so the mean tells how many
+    # runs (and which) entered each row.
+    keys = ("rms_error", "max_error", "min_clearance", "min_clearance_settled", "collisions",
+            "collisions_settled", "joint_limit_violations", "time_per_iteration_us",
+            "time_per_period_us")  # fmt: skip
+    runs = [*BOOK_RUNS, *comparison_runs(full=True)]
+    metrics = {}
+    for run in runs:
+        seed = run.overrides.get("seed", 0)
+        metrics[run.name] = {k: float(seed) for k in keys}
+    table = ch1_report._comparison(metrics)
+    for scene in SCENES:
+        for method in ("baornn", "baornn-improved"):
+            row = table[scene][method]
+            assert row["runs"] == len(ch1_report.FULL_SEEDS)
+            assert row["rms_error"] == pytest.approx(sum(ch1_report.FULL_SEEDS) / 5)
+        for method in ("pinv", "dls", "qp"):
+            assert table[scene][method]["runs"] == 1

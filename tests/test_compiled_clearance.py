@@ -113,9 +113,7 @@ def test_compiled_baornn_follows_the_python_loop():
     circle = Circle.create([0.0, 0.6, 0.5], [1, 0, 0], [0, 0, 1], 0.2, 50.0)
     runs = []
     for compiled in (True, False):
-        objective = Objective(scene, 0.005, 1.0, 0.002)
-        if not compiled:
-            object.__setattr__(objective, "compiled", None)
+        objective = Objective(scene, 0.005, 1.0, 0.002, use_compiled=compiled)
         planner = Baornn(objective, BaornnParams(0.3, 0.5, 10), np.random.default_rng(4))
         q = np.zeros(ROBOT.nq)
         qs = []
@@ -126,3 +124,20 @@ def test_compiled_baornn_follows_the_python_loop():
         assert planner.iterations == 600 and planner.evaluations == 1800
     # The two distance codes agree to ~1e-7 m, so the accepted steps are the same ones.
     assert np.allclose(runs[0], runs[1], atol=1e-6)
+
+
+def test_a_point_inside_an_obstacle_is_outside_omega_on_both_paths():
+    # Ω is d > d_min (Eq. 1.12): with d_min = 0 an overlapping antenna stays at (θ_k, g_k) on
+    # the compiled path (clearance 0) as on the coal path (negative signed distance).
+    scene = _two_obstacles()
+    rng = np.random.default_rng(11)
+    overlapping = next(
+        q for q in rng.uniform(ROBOT.lower, ROBOT.upper, (500, ROBOT.nq))
+        if scene.min_distance(q) < 0
+    )  # fmt: skip
+    current, x_ref = np.zeros(ROBOT.nq), np.array([0.2, 0.6, 0.5])
+    for compiled in (True, False):
+        objective = Objective(scene, 0.005, 1.0, 0.0, use_compiled=compiled)
+        assert (objective.compiled is not None) == compiled
+        q, g = objective.project_and_value(overlapping, current, 1.25, x_ref, 0.0)
+        assert q is current and g == 1.25

@@ -15,7 +15,8 @@ from articula.scene.scene import Scene
 
 @dataclass(frozen=True)
 class BaornnParams:
-    """Antenna length λ_k = c1·√g_k (1.23) and step δ_k = c2·λ_k (1.24); iterations per period."""
+    """Antenna length λ_k = c1·√g_k (1.23) [rad], c1 in rad/√m, and step δ_k = c2·λ_k (1.24),
+    c2 dimensionless; iterations per control period."""
 
     c1: float = 0.5
     c2: float = 0.5

@@ -19,28 +19,18 @@ def _project_and_value(
     q, q_current, g_current, x_ref, lambda_weight, beta, d_min, use_distance, lower, upper,
     arrays, static_min,
 ):  # fmt: skip
-    """(P_Ω(q), g there), Eqs. (1.17)-(1.18); stays at (q_current, g_current) if the clipped
-    point is closer than d_min to an obstacle (1.12)."""
+    """(P_Ω(q), g there), Eqs. (1.17)-(1.18); stays at (q_current, g_current) unless the
+    clipped point keeps d > d_min (1.12): clearance is 0 on overlap, so d_min = 0 still
+    rejects a point inside an obstacle."""
     clipped = np.minimum(np.maximum(q, lower), upper)
     d, ee = _evaluate(clipped, *arrays, static_min)
-    if use_distance and d < d_min:
+    if use_distance and d <= d_min:
         return q_current, g_current
     ex, ey, ez = x_ref[0] - ee[0], x_ref[1] - ee[1], x_ref[2] - ee[2]
     g = math.sqrt(ex * ex + ey * ey + ez * ez)  # Eq. (1.5)
     if lambda_weight > 0.0 and use_distance:
         g += lambda_weight / d**beta if d > 0.0 else np.inf  # Eq. (1.7)
     return clipped, g
-
-
-@njit(cache=True)
-def value(q, x_ref, lambda_weight, beta, use_distance, arrays, static_min):
-    """g(q) of Eq. (1.13) for the reference point x_ref [m] (no projection)."""
-    d, ee = _evaluate(q, *arrays, static_min)
-    ex, ey, ez = x_ref[0] - ee[0], x_ref[1] - ee[1], x_ref[2] - ee[2]
-    g = math.sqrt(ex * ex + ey * ey + ez * ez)
-    if lambda_weight > 0.0 and use_distance:
-        g += lambda_weight / d**beta if d > 0.0 else np.inf
-    return g
 
 
 @njit(cache=True)

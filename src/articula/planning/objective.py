@@ -23,11 +23,13 @@ class Objective:
     """
 
     scene: Scene
-    lambda_weight: float
+    lambda_weight: float  # Λ [m^(1+β)]
     beta: float = 1.0
     d_min: float = 0.0
-    # The compiled evaluation of the same objective, when the scene allows it (static
-    # obstacles, revolute joints, no cylinders); None: Scene (Pinocchio + coal) is used.
+    use_compiled: bool = True
+    # The compiled evaluation of the same objective, when allowed and the scene permits it
+    # (static obstacles, revolute joints, no cylinders, GJK metric); None: Scene (Pinocchio +
+    # coal) is used.
     compiled: CompiledClearance | None = field(init=False, default=None, repr=False)
 
     def __post_init__(self) -> None:
@@ -35,7 +37,8 @@ class Objective:
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
                 raise ConfigError(f"planner.{name}", f"must be finite and >= 0 (got {value})")
-        object.__setattr__(self, "compiled", CompiledClearance.build(self.scene))
+        if self.use_compiled:
+            object.__setattr__(self, "compiled", CompiledClearance.build(self.scene))
 
     def kernel_arguments(self) -> tuple:
         """Λ, β, d_min, whether distances count, joint limits and the compiled scene arrays,
@@ -43,8 +46,9 @@ class Objective:
         robot, c = self.scene.robot, self.compiled
         if c is None:
             raise ModelError("this scene has no compiled evaluation (see Objective.compiled)")
+        pairs = None if self.needs_distance else c.no_pairs  # Λ = d_min = 0: no GJK at all
         return (self.lambda_weight, self.beta, self.d_min, self.needs_distance,
-                robot.model.lowerPositionLimit, robot.model.upperPositionLimit, c.arrays(),
+                robot.model.lowerPositionLimit, robot.model.upperPositionLimit, c.arrays(pairs),
                 c.static_min)  # fmt: skip
 
     @property
@@ -55,7 +59,7 @@ class Objective:
     def value(self, q: np.ndarray, x_ref: np.ndarray, t: float = 0.0) -> float:
         """Objective g at configuration q [rad] for the reference point x_ref [m]."""
         if self.compiled is not None:
-            d, ee = self.compiled.evaluate(q)
+            d, ee = self.compiled.evaluate(q, self.needs_distance)
             return self._combine(x_ref - ee, d)
         d = self.scene.min_distance(q, t) if self.needs_distance else np.inf
         return self._value(q, x_ref, d)
@@ -63,7 +67,7 @@ class Objective:
     def tracking_error(self, q: np.ndarray, x_ref: np.ndarray) -> float:
         """The tracking term ||x_r − f(θ)|| [m] of g alone, Eq. (1.5)."""
         if self.compiled is not None:
-            e = x_ref - self.compiled.evaluate(q)[1]
+            e = x_ref - self.compiled.evaluate(q, False)[1]
             return math.sqrt(e @ e)
         robot = self.scene.robot
         robot.forward(q)
@@ -78,14 +82,14 @@ class Objective:
         query serves both the constraint and the penalty."""
         clipped = self.scene.robot.clip(q)
         if self.compiled is not None:
-            d, ee = self.compiled.evaluate(clipped)
-            if self.needs_distance and d < self.d_min:
+            d, ee = self.compiled.evaluate(clipped, self.needs_distance)
+            if self.needs_distance and d <= self.d_min:  # Ω: d > d_min (1.12); 0 on overlap
                 return q_current, g_current
             return clipped, self._combine(x_ref - ee, d)
         if not self.needs_distance:
             return clipped, self._value(clipped, x_ref, np.inf)
         d = self.scene.min_distance(clipped, t)  # also leaves the joint placements updated
-        if d < self.d_min:
+        if d <= self.d_min:  # Ω is d > d_min (1.12)
             return q_current, g_current
         return clipped, self._value(clipped, x_ref, d, kinematics_done=True)
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -23,6 +24,7 @@ class PlanResult:
     x_ref: np.ndarray
     error: np.ndarray
     clearance: np.ndarray
+    planner_seconds: float  # time spent in planner.step alone [s], not in the recording
 
 
 def track(
@@ -50,12 +52,15 @@ def track(
     x = np.empty((steps, 3))
     x_ref = np.empty((steps, 3))
     clearance = np.full(steps, np.inf)
+    planner_seconds = 0.0
     for n, tn in enumerate(t):
         x_ref[n] = trajectory(tn)
+        start = time.perf_counter()
         q = planner.step(q, x_ref[n], tn)
+        planner_seconds += time.perf_counter() - start
         qs[n] = q
         x[n] = robot.ee_position(q)
         if scene.obstacles:
             clearance[n] = scene.min_distance(q, tn)
     error = np.linalg.norm(x - x_ref, axis=1)
-    return PlanResult(t, qs, x, x_ref, error, clearance)
+    return PlanResult(t, qs, x, x_ref, error, clearance, planner_seconds)

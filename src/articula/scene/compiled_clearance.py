@@ -58,7 +58,7 @@ class CompiledClearance:
         """The arrays of `scene`, or None when it needs something this path does not cover."""
         model = scene.robot.model
         names = [model.joints[j].shortname() for j in range(1, model.njoints)]
-        if any(o.moving for o in scene.obstacles):
+        if scene.metric != "gjk" or any(o.moving for o in scene.obstacles):
             return None
         if any(name not in _AXES and name != "JointModelRevoluteUnaligned" for name in names):
             return None
@@ -123,9 +123,16 @@ class CompiledClearance:
             object.__setattr__(out, "static_min", static)
         return out
 
-    def evaluate(self, q: np.ndarray) -> tuple[float, np.ndarray]:
+    @property
+    def no_pairs(self) -> np.ndarray:
+        """An empty pair list: evaluate the kinematics only."""
+        return np.zeros((0, 3), dtype=np.int64)
+
+    def evaluate(self, q: np.ndarray, distances: bool = True) -> tuple[float, np.ndarray]:
         """(clearance [m], end-effector position [m]) at q [rad]; clearance 0 on overlap and
-        +inf without obstacles."""
+        +inf without obstacles or with `distances` False (kinematics only)."""
+        if not distances:
+            return _evaluate(q, *self.arrays(self.no_pairs), np.inf)
         return _evaluate(q, *self.arrays(), self.static_min)
 
     def arrays(self, pairs: np.ndarray | None = None) -> tuple:

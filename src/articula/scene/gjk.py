@@ -227,6 +227,7 @@ def gjk_distance(
     v = np.empty(3)
     v_new = np.empty(3)
     hint_a, hint_b = hints[a], hints[b]
+    lower = 0.0
     # Start from a point of the Minkowski difference: the support against the last answer,
     # or along the centres' offset.
     dx, dy, dz = -guess[0], -guess[1], -guess[2]
@@ -249,7 +250,12 @@ def gjk_distance(
             n = 1
         else:
             vv = _dot(v, v)
-            if vv - _dot(v, w) <= _RELATIVE_TOLERANCE * vv:
+            vw = _dot(v, w)
+            if vw > 0.0:
+                # Every point of A − B lies beyond the plane through w normal to v: a lower
+                # bound of the core distance, whatever stops the loop.
+                lower = max(lower, vw / math.sqrt(vv))
+            if vv - vw <= _RELATIVE_TOLERANCE * vv:
                 break
             W[n] = w
             n += 1
@@ -267,5 +273,5 @@ def gjk_distance(
     hints[a] = hint_a
     hints[b] = hint_b
     guess[:] = v
-    core = math.sqrt(_dot(v, v))
-    return max(core - radius_a - radius_b, 0.0)
+    # The lower bound, not |v| (an upper bound): stopping early must not over-state clearance.
+    return max(lower - radius_a - radius_b, 0.0)

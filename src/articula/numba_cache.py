@@ -1,0 +1,45 @@
+"""Keep numba's on-disk cache consistent with the sources it was compiled from.
+
+numba keys a cached function on its own file only, so a compiled function that calls a
+compiled function in another module keeps the callee's old code after that module changes
+(e.g. after `git pull` in an editable install). Before any compiled code loads, the package's
+cache files are removed whenever its compiled sources differ from those they were built from.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parent
+STAMP = "numba-sources.sha256"
+
+
+def sources_digest(root: Path) -> str:
+    """SHA-256 over every module under `root` that uses numba (path and bytes)."""
+    digest = hashlib.sha256()
+    for path in sorted(root.rglob("*.py")):
+        data = path.read_bytes()
+        if b"numba" in data:
+            digest.update(path.relative_to(root).as_posix().encode() + b"\0" + data)
+    return digest.hexdigest()
+
+
+def refresh_cache(root: Path = PACKAGE) -> bool:
+    """Delete every cached compilation under `root` if its numba sources changed since the
+    last call; returns True if it did. A read-only install is left as it is."""
+    digest = sources_digest(root)
+    stamp = root / "__pycache__" / STAMP
+    try:
+        if stamp.read_text(encoding="ascii") == digest:
+            return False
+    except OSError:
+        pass  # no stamp yet
+    try:
+        for cached in [*root.rglob("__pycache__/*.nbi"), *root.rglob("__pycache__/*.nbc")]:
+            cached.unlink(missing_ok=True)
+        stamp.parent.mkdir(exist_ok=True)
+        stamp.write_text(digest, encoding="ascii")
+    except OSError:
+        return False  # not writable: numba then caches in its user-wide folder
+    return True
