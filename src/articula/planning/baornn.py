@@ -23,21 +23,21 @@ class BaornnParams:
     iterations_per_step: int = 10
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.c1) and self.c1 > 0 and np.isfinite(self.c2) and self.c2 > 0):
-            raise ConfigError("planner.c1/c2", f"must be finite and > 0 (got {self.c1}, {self.c2})")
-        if self.iterations_per_step < 1:
-            raise ConfigError("planner.iterations_per_step", "must be >= 1")
+        check_step_constants(self.c1, self.c2, self.iterations_per_step)
 
 
-@dataclass
-class Baornn:
-    """The faithful algorithm of Sect. 1.3.1; all randomness from the injected generator."""
+def check_step_constants(c1: float, c2: float, iterations_per_step: int) -> None:
+    """ConfigError unless c1, c2 are finite and > 0 and there is at least one iteration."""
+    if not (np.isfinite(c1) and c1 > 0 and np.isfinite(c2) and c2 > 0):
+        raise ConfigError("planner.c1/c2", f"must be finite and > 0 (got {c1}, {c2})")
+    if iterations_per_step < 1:
+        raise ConfigError("planner.iterations_per_step", "must be >= 1")
+
+
+class OnObjective:
+    """The Planner properties of a planner that searches an Objective."""
 
     objective: Objective
-    params: BaornnParams
-    rng: np.random.Generator
-    evaluations: int = field(default=0, init=False)
-    iterations: int = field(default=0, init=False)
 
     @property
     def scene(self) -> Scene:
@@ -48,6 +48,17 @@ class Baornn:
     def d_min(self) -> float:
         """The hard clearance [m] of the objective (Eq. 1.12)."""
         return self.objective.d_min
+
+
+@dataclass
+class Baornn(OnObjective):
+    """The faithful algorithm of Sect. 1.3.1; all randomness from the injected generator."""
+
+    objective: Objective
+    params: BaornnParams
+    rng: np.random.Generator
+    evaluations: int = field(default=0, init=False)
+    iterations: int = field(default=0, init=False)
 
     def iterate(
         self, q: np.ndarray, g: float, x_ref: np.ndarray, t: float

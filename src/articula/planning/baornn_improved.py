@@ -18,8 +18,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from articula.errors import ConfigError
+from articula.planning.baornn import OnObjective, check_step_constants
 from articula.planning.objective import Objective
-from articula.scene.scene import Scene
 
 
 @dataclass(frozen=True)
@@ -32,14 +32,13 @@ class ImprovedParams:
     iterations_per_step: int = 10
 
     def __post_init__(self) -> None:
-        if not (np.isfinite(self.c1) and self.c1 > 0 and np.isfinite(self.c2) and self.c2 > 0):
-            raise ConfigError("planner.c1/c2", f"must be finite and > 0 (got {self.c1}, {self.c2})")
-        if self.iterations_per_step < 1 or self.pairs < 1:
-            raise ConfigError("planner.iterations_per_step/pairs", "must be >= 1")
+        check_step_constants(self.c1, self.c2, self.iterations_per_step)
+        if self.pairs < 1:
+            raise ConfigError("planner.pairs", "must be >= 1")
 
 
 @dataclass
-class ImprovedBaornn:
+class ImprovedBaornn(OnObjective):
     """Algorithm 1 with the changes above; the same objective, projection and acceptance."""
 
     objective: Objective
@@ -48,16 +47,6 @@ class ImprovedBaornn:
     evaluations: int = field(default=0, init=False)
     iterations: int = field(default=0, init=False)
     _last_motion: np.ndarray | None = field(default=None, init=False)
-
-    @property
-    def scene(self) -> Scene:
-        """The scene of the objective."""
-        return self.objective.scene
-
-    @property
-    def d_min(self) -> float:
-        """The hard clearance [m] of the objective (Eq. 1.12)."""
-        return self.objective.d_min
 
     def iterate(
         self, q: np.ndarray, g: float, x_ref: np.ndarray, t: float

@@ -5,9 +5,6 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
@@ -15,6 +12,7 @@ from scipy.spatial import ConvexHull
 
 from articula.geometry.poses import transform_points
 from articula.scene.scene import Scene
+from articula.viz.figures import save
 
 
 def joint_points(scene: Scene, q: np.ndarray) -> np.ndarray:
@@ -57,7 +55,7 @@ def paths(scene: Scene, trace: Mapping[str, np.ndarray], title: str, path: Path)
     top.grid(True, alpha=0.3)
     top.legend(fontsize=7, loc="best")
     fig.suptitle(title)
-    _save(fig, path)
+    save(fig, path)
 
 
 def time_series(trace: Mapping[str, np.ndarray], title: str, path: Path) -> None:
@@ -89,7 +87,7 @@ def time_series(trace: Mapping[str, np.ndarray], title: str, path: Path) -> None
     for ax in axes.flat:
         ax.grid(True, alpha=0.3)
     fig.suptitle(title)
-    _save(fig, path)
+    save(fig, path)
 
 
 def snapshots(
@@ -116,7 +114,7 @@ def snapshots(
     _equal_3d(ax, np.vstack([*shown, ref]))
     ax.legend(fontsize=7)
     fig.suptitle(title)
-    _save(fig, path)
+    save(fig, path)
 
 
 def joint_matrix(trace: Mapping[str, np.ndarray]) -> np.ndarray:
@@ -164,10 +162,3 @@ def _lines(ax: plt.Axes, t: np.ndarray, values: np.ndarray, label: str) -> None:
         ax.plot(t, values[:, j], lw=0.8, label=f"joint {j + 1}")
     ax.set_ylabel(label)
     ax.legend(fontsize=6, ncol=2)
-
-
-def _save(fig: plt.Figure, path: Path) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)

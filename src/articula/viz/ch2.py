@@ -5,14 +5,12 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
 from articula.tuning.coordinate_descent import DescentResult
 from articula.tuning.manual import ManualResult
+from articula.viz.figures import save
 
 
 def manual_steps(result: ManualResult, title: str, path: Path) -> None:
@@ -37,7 +35,7 @@ def manual_steps(result: ManualResult, title: str, path: Path) -> None:
     ax.set_title(title)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="lower right")
-    _save(fig, path)
+    save(fig, path)
 
 
 def convergence(runs: Mapping[str, DescentResult], path: Path) -> None:
@@ -56,7 +54,7 @@ def convergence(runs: Mapping[str, DescentResult], path: Path) -> None:
         ax.set_ylabel("gain")
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8, loc="upper right")
-    _save(fig, path)
+    save(fig, path)
 
 
 def sinusoid_trials(traces: Mapping[str, Mapping[str, np.ndarray]], title: str, path: Path) -> None:
@@ -73,7 +71,7 @@ def sinusoid_trials(traces: Mapping[str, Mapping[str, np.ndarray]], title: str, 
         ax.set_ylabel("angle [°]")
     axes[0, 0].legend(fontsize=8, loc="upper right")
     fig.suptitle(title)
-    _save(fig, path)
+    save(fig, path)
 
 
 def error_summary(
@@ -110,11 +108,4 @@ def error_summary(
         ax.grid(True, which="both", alpha=0.3)
     axes[0].set_ylabel("E [°]")
     axes[0].legend(fontsize=8)
-    _save(fig, path)
-
-
-def _save(fig: plt.Figure, path: Path) -> None:
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)

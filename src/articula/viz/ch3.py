@@ -5,11 +5,10 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+
+from articula.viz.figures import save
 
 Curve = tuple[np.ndarray, np.ndarray]
 
@@ -45,7 +44,7 @@ def delta_study(
     for ax in axes:
         ax.grid(True, alpha=0.3)
     fig.suptitle("Fig. 3.7: deactuation of one chamber with the opposite chamber pulsed at δ")
-    _save(fig, path)
+    save(fig, path)
 
 
 def timing_map(
@@ -59,7 +58,7 @@ def timing_map(
     ax.set_xlabel("pulse start after the deactuation command [s]")
     ax.set_ylabel("pulse length: fill, hold, until venting [s]")
     ax.set_title(f"Opposite-chamber pulse timing at δ = {delta:g}")
-    _save(fig, path)
+    save(fig, path)
 
 
 def best_pulse(curves: Mapping[str, Curve], pressures: Mapping[str, Curve], path: Path) -> None:
@@ -77,7 +76,7 @@ def best_pulse(curves: Mapping[str, Curve], pressures: Mapping[str, Curve], path
     for ax in axes:
         ax.grid(True, alpha=0.3)
     axes[0].set_title("Deactuation with the opposite-chamber pulse found by coordinate descent")
-    _save(fig, path)
+    save(fig, path)
 
 
 def _edges(centres: np.ndarray) -> np.ndarray:
@@ -87,10 +86,3 @@ def _edges(centres: np.ndarray) -> np.ndarray:
         return np.array([c[0] - 0.5, c[0] + 0.5])
     mid = (c[1:] + c[:-1]) / 2
     return np.concatenate([[2 * c[0] - mid[0]], mid, [2 * c[-1] - mid[-1]]])
-
-
-def _save(fig: plt.Figure, path: Path) -> None:
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)

@@ -5,11 +5,10 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+
+from articula.viz.figures import save
 
 
 def current_speed_line(
@@ -25,7 +24,7 @@ def current_speed_line(
     ax.set_title(title)
     ax.grid(True, alpha=0.3)
     ax.legend()
-    _save(fig, path)
+    save(fig, path)
 
 
 def response(trace: Mapping[str, np.ndarray], title: str, path: Path, pwm_bits: int) -> None:
@@ -56,7 +55,7 @@ def response(trace: Mapping[str, np.ndarray], title: str, path: Path, pwm_bits: 
     for a in axes:
         a.grid(True, alpha=0.3)
     axes[0].set_title(title)
-    _save(fig, path)
+    save(fig, path)
 
 
 def bandwidth_tradeoff(
@@ -91,11 +90,4 @@ def bandwidth_tradeoff(
     for a in axes:
         a.grid(True, which="both", alpha=0.3)
     fig.suptitle("Current loop: bandwidth and feedback noise against moving-average order")
-    _save(fig, path)
-
-
-def _save(fig: plt.Figure, path: Path) -> None:
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)
