@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from articula.errors import ConfigError
+from articula.planning import baornn_kernel as kernel
 from articula.planning.baornn import OnObjective, check_step_constants
 from articula.planning.objective import Objective
 
@@ -53,9 +54,12 @@ class ImprovedBaornn(OnObjective):
     ) -> tuple[np.ndarray, float]:
         """One iteration from (q, g = g(q)); returns the accepted (q, g)."""
         obj, p = self.objective, self.params
+        draw = self.rng.standard_normal((q.size, min(p.pairs, q.size)))
+        if obj.compiled is not None:
+            return self._compiled(q, g, x_ref, draw[None])
         lam = p.c1 * math.sqrt(obj.tracking_error(q, x_ref))
         # Orthonormal directions: QR of a Gaussian matrix (columns), as many as pairs.
-        directions, _ = np.linalg.qr(self.rng.standard_normal((q.size, min(p.pairs, q.size))))
+        directions, _ = np.linalg.qr(draw)
         gradient = np.zeros(q.size)
         best_q, best_g = q, g
         for b in directions.T:
@@ -86,7 +90,28 @@ class ImprovedBaornn(OnObjective):
             self.evaluations += 1
             if g_warm < g:
                 q, g = q_warm, g_warm
-        for _ in range(self.params.iterations_per_step):
-            q, g = self.iterate(q, g, x_ref, t)
+        p = self.params
+        if self.objective.compiled is not None:
+            # The same draws as iterations_per_step calls of iterate, in one compiled call.
+            draws = self.rng.standard_normal((p.iterations_per_step, q.size, min(p.pairs, q.size)))
+            q, g = self._compiled(q, g, x_ref, draws)
+        else:
+            for _ in range(p.iterations_per_step):
+                q, g = self.iterate(q, g, x_ref, t)
         self._last_motion = q - start
         return q
+
+    def _compiled(
+        self, q: np.ndarray, g: float, x_ref: np.ndarray, draws: np.ndarray
+    ) -> tuple[np.ndarray, float]:
+        """The iterations of `draws` by planning/baornn_kernel.py."""
+        obj, p = self.objective, self.params
+        (lambda_weight, beta, d_min, use_distance, lower, upper, arrays,
+         static_min) = obj.kernel_arguments()  # fmt: skip
+        q, g, evaluations = kernel.improved_iterations(
+            q, g, x_ref, draws, p.c1, p.c2, lambda_weight, beta, d_min, use_distance, lower,
+            upper, arrays, obj.kinematics_arguments(), static_min,
+        )  # fmt: skip
+        self.evaluations += evaluations
+        self.iterations += draws.shape[0]
+        return q, g

@@ -58,3 +58,48 @@ def iterations(
         if g_new < g:  # Eqs. (1.21)-(1.22)
             q, g = q_new, g_new
     return q, g
+
+
+@njit(cache=True)
+def improved_iterations(
+    q, g, x_ref, draws, c1, c2, lambda_weight, beta, d_min, use_distance, lower, upper,
+    arrays, kinematics, static_min,
+):  # fmt: skip
+    """baornn-improved's iterations (planning/baornn_improved.py), one per draws[k], an
+    (n × pairs) Gaussian matrix whose QR gives the antenna directions; returns the accepted
+    (q, g) and the number of objective evaluations."""
+    n = q.size
+    evaluations = 0
+    for k in range(draws.shape[0]):
+        _, ee = _evaluate(q, *kinematics, np.inf)
+        ex, ey, ez = x_ref[0] - ee[0], x_ref[1] - ee[1], x_ref[2] - ee[2]
+        lam = c1 * math.sqrt(math.sqrt(ex * ex + ey * ey + ez * ez))  # c1·√e_k
+        directions, _ = np.linalg.qr(draws[k])
+        gradient = np.zeros(n)
+        best_q, best_g = q, g
+        for j in range(directions.shape[1]):
+            b = np.ascontiguousarray(directions[:, j])
+            q_left, g_left = _project_and_value(q + lam * b, q, g, x_ref, lambda_weight, beta,
+                                                d_min, use_distance, lower, upper, arrays,
+                                                static_min)  # fmt: skip
+            q_right, g_right = _project_and_value(q - lam * b, q, g, x_ref, lambda_weight,
+                                                  beta, d_min, use_distance, lower, upper,
+                                                  arrays, static_min)  # fmt: skip
+            evaluations += 2
+            if math.isfinite(g_left) and math.isfinite(g_right):
+                gradient += (g_left - g_right) * b
+            if g_left < best_g:
+                best_q, best_g = q_left, g_left
+            if g_right < best_g:
+                best_q, best_g = q_right, g_right
+        norm = math.sqrt(gradient @ gradient)
+        if norm > 0.0:
+            step = q - c2 * lam * gradient / norm  # Eq. (1.19) along the estimated gradient
+            q_new, g_new = _project_and_value(step, q, g, x_ref, lambda_weight, beta, d_min,
+                                              use_distance, lower, upper, arrays,
+                                              static_min)  # fmt: skip
+            evaluations += 1
+            if g_new < best_g:  # Eqs. (1.21)-(1.22)
+                best_q, best_g = q_new, g_new
+        q, g = best_q, best_g
+    return q, g, evaluations

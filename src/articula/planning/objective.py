@@ -56,6 +56,12 @@ class Objective:
         """False when neither the penalty nor the hard bound uses the obstacles (Λ = d_min = 0)."""
         return bool(self.scene.obstacles) and (self.lambda_weight > 0 or self.d_min > 0)
 
+    def kinematics_arguments(self) -> tuple:
+        """The compiled scene arrays without any pair: forward kinematics only."""
+        if self.compiled is None:
+            raise ModelError("this scene has no compiled evaluation (see Objective.compiled)")
+        return self.compiled.arrays(self.compiled.no_pairs)
+
     def value(self, q: np.ndarray, x_ref: np.ndarray, t: float = 0.0) -> float:
         """Objective g at configuration q [rad] for the reference point x_ref [m]."""
         if self.compiled is not None:
