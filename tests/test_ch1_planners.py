@@ -447,3 +447,27 @@ def test_qp_params_refuse_a_safety_distance_beyond_the_influence():
         QpIkParams(influence=0.1, safety=0.1)
     with pytest.raises(ConfigError, match="safety"):
         QpIkParams(limit_influence=0.1, limit_safety=0.2)
+
+
+def test_settle_defaults_to_five_seconds_or_half_the_run():
+    assert PlannerSpec().settle == 5.0
+    assert PlannerSpec(duration=2.0).settle == 1.0
+    assert PlannerSpec(duration=2.0, settle=0.5).settle == 0.5
+
+
+def test_the_run_config_keeps_mesh_paths_that_still_resolve(tmp_path):
+    scene_dir = tmp_path / "scenes"
+    scene_dir.mkdir()
+    configs = Path(__file__).resolve().parents[1] / "src/articula/experiments/configs/ch1"
+    (scene_dir / "rock.stl").write_bytes((configs / "rock.stl").read_bytes())
+    data = {
+        "robot": {"builtin": "iiwa14"},
+        "obstacles": [{"name": "rock", "mesh": "rock.stl", "position": [0.0, 0.3, 0.9]}],
+        "trajectory": {"type": "circle", "center": [0.0, 0.6, 0.5], "axis_a": [1.0, 0.0, 0.0],
+                       "axis_b": [0.0, 0.0, 1.0], "radius": 0.2, "period": 50.0},
+        "planner": {"duration": 0.2, "settle": 0.1, "tolerance": 10.0},
+    }  # fmt: skip
+    config, _, _ = plan_data(data, scene_dir, "scene.toml")
+    mesh = Path(config["obstacles"][0]["mesh"])
+    assert mesh.is_absolute() and mesh.exists()
+    assert data["obstacles"][0]["mesh"] == "rock.stl"  # the caller's mapping is untouched

@@ -169,11 +169,13 @@ def motor_analyze(
 
 @app.command()
 def plan(
-    scene_file: Annotated[Path, typer.Argument(help="Scene file with [trajectory], [planner].")],
+    scene_file: Annotated[
+        Path, typer.Argument(help="Scene file with trajectory and planner tables (TOML).")
+    ],
     out_dir: OutDir,
     as_json: JsonFlag = False,
 ) -> None:
-    """Track the scene's reference path with BAORNN; writes a run folder (trace + record)."""
+    """Track the scene's reference path with its planner; writes a run folder (trace + record)."""
     from articula.experiments.ch1_plan import plan_to_folder
 
     record = plan_to_folder(scene_file, out_dir)

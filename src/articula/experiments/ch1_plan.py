@@ -21,7 +21,7 @@ from articula.planning.reach import check_reach
 from articula.planning.track import PlanResult, track
 from articula.planning.trajectories import Circle, Waypoints, rectangle
 from articula.planning.velocity_ik import VelocityIk, VelocityIkParams
-from articula.scene.config import build_scene, load_scene_spec
+from articula.scene.config import build_scene, load_scene_spec, resolve_path
 from articula.scene.scene import Scene
 from articula.validation import StrictModel, field_error, load_toml, parse_model
 
@@ -77,7 +77,7 @@ class PlannerSpec(StrictModel):
     dt: Positive = 0.01  # [s] control period
     iterations_per_step: Annotated[int, Field(ge=1, le=10_000)] = 10
     duration: Positive = 50.0  # [s]
-    settle: NonNegative = 5.0  # [s] before rms_error and max_error are taken
+    settle: NonNegative | None = None  # [s] before rms_error and max_error; default min(5, T/2)
     tolerance: Positive = 0.05  # [m] an rms_error above it means the path was not tracked
     c1: Positive = 0.5
     c2: Positive = 0.5
@@ -91,6 +91,8 @@ class PlannerSpec(StrictModel):
 
     @model_validator(mode="after")
     def _times(self) -> PlannerSpec:
+        if self.settle is None:
+            object.__setattr__(self, "settle", min(5.0, self.duration / 2))
         if self.settle >= self.duration:
             raise field_error("settle", f"must be shorter than duration = {self.duration} s")
         if self.safety >= self.influence:
@@ -165,7 +167,7 @@ def plan_data(
     config = {
         "experiment": "baornn.plan",
         "seed": p.seed,
-        **{k: v for k, v in data.items() if k in ("robot", "obstacles")},
+        **_with_absolute_paths(data, base_dir),
         "trajectory": trajectory_spec.model_dump(mode="json", exclude_none=True),
         "planner": planner_spec.model_dump(mode="json"),
     }
@@ -177,6 +179,29 @@ def plan_data(
             f"{p.tolerance} m; the path may be out of reach or blocked"
         )
     return config, Result(metrics, _trace(result)), wall
+
+
+def _with_absolute_paths(data: dict[str, Any], base_dir: Path) -> dict[str, Any]:
+    """The [robot] and [[obstacles]] tables with file paths made absolute, so that the
+    config.toml of a run folder still finds its URDF and meshes."""
+
+    def absolute(path: str) -> str:
+        return str(resolve_path(base_dir, path).resolve())
+
+    out: dict[str, Any] = {}
+    if "robot" in data:
+        robot = dict(data["robot"])
+        if isinstance(robot.get("urdf"), str):
+            robot["urdf"] = absolute(robot["urdf"])
+        if isinstance(robot.get("package_dirs"), list):
+            robot["package_dirs"] = [absolute(d) for d in robot["package_dirs"]]
+        out["robot"] = robot
+    if "obstacles" in data:
+        out["obstacles"] = [
+            {**o, "mesh": absolute(o["mesh"])} if isinstance(o.get("mesh"), str) else o
+            for o in data["obstacles"]
+        ]
+    return out
 
 
 def _metrics(r: PlanResult, robot: Any, settle: float, iterations: float) -> dict[str, float]:

@@ -43,5 +43,5 @@ def check_reach(
             raise InfeasibleError(
                 f"trajectory: unreachable: at t = {t:.2f} s the path is {distance:.3f} m from "
                 f"the first joint, beyond the arm's reach of {radius:.3f} m (the error cannot "
-                f"fall below {distance - radius:.3f} m)"
+                f"fall below {distance - radius:.3g} m)"
             )

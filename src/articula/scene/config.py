@@ -90,7 +90,9 @@ def build_scene(
         robot = RobotModel.builtin(r.builtin)
     else:
         robot = RobotModel.from_urdf(
-            _path(base_dir, r.urdf or ""), [_path(base_dir, d) for d in r.package_dirs], r.ee_frame
+            resolve_path(base_dir, r.urdf or ""),
+            [resolve_path(base_dir, d) for d in r.package_dirs],
+            r.ee_frame,
         )
     q0 = robot.check_q(r.q0 if r.q0 is not None else np.zeros(robot.nq), "robot.q0")
     obstacles = []
@@ -106,7 +108,7 @@ def _obstacle(spec: ObstacleSpec, index: int, base_dir: Path) -> Obstacle:
     name = spec.name or f"obstacle_{index}"
     parts: list[ConvexShape]
     if spec.mesh is not None:
-        mesh_path = _path(base_dir, spec.mesh)
+        mesh_path = resolve_path(base_dir, spec.mesh)
         scale = tuple(spec.scale) if isinstance(spec.scale, list) else spec.scale
         parts = convex_parts(load_mesh(mesh_path, scale), name, decompose=spec.decompose)
     else:
@@ -136,6 +138,7 @@ def _primitive(spec: ObstacleSpec) -> ConvexShape:
     return capsule(radius, length)
 
 
-def _path(base_dir: Path, text: str) -> Path:
+def resolve_path(base_dir: Path, text: str) -> Path:
+    """A path from a scene file: `~` expanded, relative ones taken from `base_dir`."""
     path = Path(text).expanduser()
     return path if path.is_absolute() else base_dir / path
