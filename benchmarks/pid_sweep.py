@@ -9,10 +9,11 @@ Table 2.2. Target <= 60 s on 2 cores.
 batch_speedup: wall time per trial of 25 trials run one by one (25 calls of the registered
 experiment with trials = 1 and seeds 0-24) divided by the same 25 trials as one batch (one
 call with trials = 25), for the 0.5 Hz run of the fuzzy PID; both in this process, each
-the fastest of five timings taken in turns. Target >= 20. The ratio is bounded by the batch size, 25: with a per-step cost c that a batch pays
-once (Python, the PID and plant calls) and a cost v per trial and step, it is
-25 (c + v) / (c + 25 v) < 25 (cache effects aside). A value near 25 says the loop is
-overhead-bound and batching removes nearly all of it; it is not a figure that can keep growing.
+the fastest of five timings taken in turns. Target >= 20. The ratio is bounded by the batch
+size, 25: with a per-step cost c that a batch pays once (Python, the PID and plant calls) and
+a cost v per trial and step, it is 25 (c + v) / (c + 25 v) < 25 (cache effects aside). A
+value near 25 says the loop is overhead-bound and batching removes nearly all of it; it is not
+a figure that can keep growing.
 """
 
 from __future__ import annotations
