@@ -109,9 +109,7 @@ def sweep(
 
 @app.command()
 def reproduce(
-    chapter: Annotated[
-        str, typer.Argument(help="A chapter (ch3, ch4, ...) or all; unbuilt chapters are refused.")
-    ] = "all",
+    chapter: Annotated[str, typer.Argument(help="ch1, ch2, ch3, ch4 or all.")] = "all",
     out_dir: OutDir = Path("report"),
     full: Annotated[bool, typer.Option("--full", help="Full-size runs instead of quick.")] = False,
     workers: Annotated[
@@ -192,7 +190,7 @@ def plan(
 @scene_app.command("check")
 def scene_check(
     scene_file: Annotated[
-        Path, typer.Argument(help="Scene file (TOML with [robot], [[obstacles]]).")
+        Path, typer.Argument(help="Scene file (TOML with robot and obstacles tables).")
     ],
     q: Annotated[
         str | None, typer.Option("--q", help="Joint values q1,q2,... [rad]; default q0.")

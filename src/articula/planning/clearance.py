@@ -26,15 +26,17 @@ def clearance_rows(scene: Scene, q: np.ndarray, t: float, influence: float) -> C
     """
     robot = scene.robot
     w = scene.witnesses(q, t)
-    rows, grads = [], []
+    rows, normals, frames, points = [], [], [], []
     for li, oi in zip(*np.nonzero(w.distance < influence), strict=True):
         d = w.distance[li, oi]
         gap = w.on_link[li, oi] - w.on_obstacle[li, oi]
         length = np.linalg.norm(gap)
         if length < 1e-9:
             continue  # touching: no direction to move away along
-        n = gap / length * (1.0 if d >= 0 else -1.0)
-        J = robot.point_jacobian(q, robot.links[li].frame_id, w.on_link[li, oi])
         rows.append(d)
-        grads.append(n @ J)
+        normals.append(gap / length * (1.0 if d >= 0 else -1.0))
+        frames.append(robot.links[li].frame_id)
+        points.append(w.on_link[li, oi])
+    jacobians = robot.point_jacobians(q, frames, points)
+    grads = [n @ J for n, J in zip(normals, jacobians, strict=True)]
     return ClearanceRows(np.array(rows), np.array(grads).reshape(len(rows), robot.nq))

@@ -152,17 +152,26 @@ class RobotModel:
         ).copy()
 
     def point_jacobian(self, q: np.ndarray, frame_id: int, point: np.ndarray) -> np.ndarray:
-        """3×nq Jacobian of a world point [m] moving rigidly with frame `frame_id`.
+        """3×nq Jacobian of a world point [m] moving rigidly with frame `frame_id`."""
+        return self.point_jacobians(q, [frame_id], [point])[0]
+
+    def point_jacobians(
+        self, q: np.ndarray, frame_ids: Sequence[int], points: Sequence[np.ndarray]
+    ) -> list[np.ndarray]:
+        """3×nq Jacobians of world points [m], each moving rigidly with its frame; the joint
+        Jacobians are computed once for all of them.
 
         v_p = v_o + ω × (p − o) at the parent joint's origin o, in world axes.
         """
-        joint = self.model.frames[frame_id].parentJoint
         pin.computeJointJacobians(self.model, self.data, q)
-        J = pin.getJointJacobian(
-            self.model, self.data, joint, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-        )
-        r = point - self.data.oMi[joint].translation
-        return J[:3] - _skew(r) @ J[3:]
+        out = []
+        for frame_id, point in zip(frame_ids, points, strict=True):
+            joint = self.model.frames[frame_id].parentJoint
+            J = pin.getJointJacobian(
+                self.model, self.data, joint, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+            )
+            out.append(J[:3] - _skew(point - self.data.oMi[joint].translation) @ J[3:])
+        return out
 
 
 def _skew(v: np.ndarray) -> np.ndarray:

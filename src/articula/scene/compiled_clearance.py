@@ -12,6 +12,7 @@ Scene.min_distance. Clearance is GJK distance, and 0 when shapes overlap (no dep
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 import pinocchio as pin
@@ -123,10 +124,7 @@ class CompiledClearance:
             object.__setattr__(out, "static_min", static)
         return out
 
-    @property
-    def no_pairs(self) -> np.ndarray:
-        """An empty pair list: evaluate the kinematics only."""
-        return np.zeros((0, 3), dtype=np.int64)
+    no_pairs: ClassVar[np.ndarray] = np.zeros((0, 3), dtype=np.int64)  # kinematics only
 
     def evaluate(self, q: np.ndarray, distances: bool = True) -> tuple[float, np.ndarray]:
         """(clearance [m], end-effector position [m]) at q [rad]; clearance 0 on overlap and
