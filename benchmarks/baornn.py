@@ -19,8 +19,6 @@ Target: iteration_us <= 40.
 
 from __future__ import annotations
 
-import argparse
-import json
 import statistics
 import time
 from collections.abc import Callable
@@ -28,30 +26,30 @@ from importlib import resources
 from pathlib import Path
 
 import numpy as np
+from common import run
 from distance import bare_coal_loop
 
+from articula.loops.tracking import track
 from articula.planning.baornn import Baornn, BaornnParams
 from articula.planning.objective import Objective
-from articula.planning.track import track
 from articula.planning.trajectories import Circle
 from articula.scene.config import build_scene, load_scene_spec
 from articula.validation import load_toml
 
 
 def measure() -> dict[str, float]:
-    path = Path(
-        str(
-            resources.files("articula.experiments")
-            / "configs"
-            / "ch1"
-            / "circle_two_obstacles.toml"
-        )
-    )
+    path = Path(str(resources.files("articula.book.ch1") / "configs" / "circle_two_obstacles.toml"))
     scene, q0 = build_scene(load_scene_spec(load_toml(path)), path.parent)
     objective = Objective(scene, 0.005, 1.0, 0.002)
     coal_objective = Objective(scene, 0.005, 1.0, 0.002, use_compiled=False)
-    planner = Baornn(objective, BaornnParams(0.3, 0.5, 10), np.random.default_rng(0))
-    coal_planner = Baornn(coal_objective, BaornnParams(0.3, 0.5, 10), np.random.default_rng(0))
+    planner = Baornn(
+        objective, BaornnParams(c1=0.3, c2=0.5, iterations_per_step=10), np.random.default_rng(0)
+    )
+    coal_planner = Baornn(
+        coal_objective,
+        BaornnParams(c1=0.3, c2=0.5, iterations_per_step=10),
+        np.random.default_rng(0),
+    )
     circle = Circle.create([0.0, 0.6, 0.5], [1, 0, 0], [0, 0, 1], 0.2, 50.0)
     run = track(planner, circle, q0, 0.01, 10.0)
     bare_min = bare_coal_loop(scene)
@@ -88,33 +86,18 @@ def _bare_evaluations(bare_min: Callable[[np.ndarray], float], q: np.ndarray) ->
         bare_min(q)
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--json", action="store_true", help="print one JSON object")
-    args = parser.parse_args()
-    m = measure()
-    if args.json:
-        print(json.dumps(m))
-        return
-    from rich.console import Console
-    from rich.table import Table
-
-    table = Table(
-        title=f"one BAORNN iteration, median over {int(m['configurations'])} configurations"
-    )
-    for col in ("measure", "µs", "target"):
-        table.add_column(col)
+def table(m: dict[str, float]) -> tuple[str, list[str], list[list[str]]]:
+    """The measures as (title, columns, rows) for a person."""
     rows = [
-        ("iteration_us (Baornn.step / 10, compiled)", m["iteration_us"], "<= 40"),
-        ("single_iterate_us (one Baornn.iterate call)", m["single_iterate_us"], ""),
-        ("iteration_coal_us (Baornn.step / 10, coal)", m["iteration_coal_us"], ""),
-        ("bare_calls_us (3 × FK + bare coal min distance)", m["bare_calls_us"], ""),
+        ["iteration_us (Baornn.step / 10, compiled)", f"{m['iteration_us']:.1f}", "<= 40"],
+        ["single_iterate_us (one Baornn.iterate call)", f"{m['single_iterate_us']:.1f}", ""],
+        ["iteration_coal_us (Baornn.step / 10, coal)", f"{m['iteration_coal_us']:.1f}", ""],
+        ["bare_calls_us (3 × FK + bare coal min distance)", f"{m['bare_calls_us']:.1f}", ""],
+        ["speedup_vs_coal", f"{m['speedup_vs_coal']:.2f}×", ""],
     ]
-    for name, value, target in rows:
-        table.add_row(name, f"{value:.1f}", target)
-    table.add_row("speedup_vs_coal", f"{m['speedup_vs_coal']:.2f}×", "")
-    Console().print(table)
+    title = f"one BAORNN iteration, median over {int(m['configurations'])} configurations"
+    return title, ["measure", "µs", "target"], rows
 
 
 if __name__ == "__main__":
-    main()
+    run(__doc__, measure, table)

@@ -2,7 +2,7 @@
 
     python benchmarks/distance.py [--json]
 
-Scene: src/articula/experiments/configs/ch1/two_obstacles.toml (a bracket and a rock in front
+Scene: src/articula/book/ch1/configs/two_obstacles.toml (a bracket and a rock in front
 of the robot, Figs. 1.11-1.12 style). Configurations: random joint vectors within 60 % of the
 limits with the robot clear of both obstacles (the planner's usual situation). For each, the
 median time of one call:
@@ -17,8 +17,6 @@ bare_coal_us.
 
 from __future__ import annotations
 
-import argparse
-import json
 import statistics
 import time
 from importlib import resources
@@ -27,6 +25,7 @@ from pathlib import Path
 import coal
 import numpy as np
 import pinocchio as pin
+from common import run
 
 from articula.scene.config import build_scene, load_scene_spec
 from articula.validation import load_toml
@@ -36,9 +35,7 @@ REPEATS = 5
 
 
 def _scene_file() -> Path:
-    return Path(
-        str(resources.files("articula.experiments") / "configs" / "ch1" / "two_obstacles.toml")
-    )
+    return Path(str(resources.files("articula.book.ch1") / "configs" / "two_obstacles.toml"))
 
 
 def _median_us(fn, Q: np.ndarray) -> float:
@@ -112,49 +109,26 @@ def measure() -> dict[str, float]:
     }
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--json", action="store_true", help="print one JSON object")
-    args = parser.parse_args()
-    m = measure()
-    if args.json:
-        print(json.dumps(m))
-        return
-    from rich.console import Console
-    from rich.table import Table
-
+def table(m: dict[str, float]) -> tuple[str, list[str], list[list[str]]]:
+    """The measures as (title, columns, rows) for a person, each against the bare coal loop."""
     bare = m["bare_coal_us"]
-    table = Table(
-        title="iiwa14 vs two mesh obstacles: median per configuration over "
+
+    def row(name: str, key: str, target: str) -> list[str]:
+        return [name, f"{m[key]:.2f}", f"{m[key] / bare:.2f}", target]
+
+    rows = [
+        ["bare coal loop (baseline)", f"{bare:.2f}", "1.00", ""],
+        row("min_distance, no broad phase", "min_distance_us", "<= 1.3"),
+        row("min_distance, broad phase", "broadphase_us", "< 1, <= 10 µs"),
+        row("book's vertex-pair formula", "vertex_formula_us", ""),
+        ["largest |bare - library| [m]", f"{m['bare_vs_library_max_abs_diff_m']:.2e}", "", ""],
+    ]
+    title = (
+        "iiwa14 vs two mesh obstacles: median per configuration over "
         f"{int(m['configurations'])} configurations"
     )
-    for col in ("method", "µs", "× bare coal loop", "target"):
-        table.add_column(col)
-    table.add_row("bare coal loop (baseline)", f"{bare:.2f}", "1.00", "")
-    table.add_row(
-        "min_distance, no broad phase",
-        f"{m['min_distance_us']:.2f}",
-        f"{m['min_distance_us'] / bare:.2f}",
-        "<= 1.3",
-    )
-    table.add_row(
-        "min_distance, broad phase",
-        f"{m['broadphase_us']:.2f}",
-        f"{m['broadphase_us'] / bare:.2f}",
-        "< 1, <= 10 µs",
-    )
-    table.add_row(
-        "book's vertex-pair formula",
-        f"{m['vertex_formula_us']:.2f}",
-        f"{m['vertex_formula_us'] / bare:.2f}",
-        "",
-    )
-    Console().print(table)
-    print(
-        "largest |bare - library| over 200 configurations: "
-        f"{m['bare_vs_library_max_abs_diff_m']:.2e} m"
-    )
+    return title, ["method", "µs", "× bare coal loop", "target"], rows
 
 
 if __name__ == "__main__":
-    main()
+    run(__doc__, measure, table)

@@ -15,15 +15,13 @@ in the same process as the baseline for the compiled one.
 
 from __future__ import annotations
 
-import argparse
-import json
 import statistics
 import time
 
 import numpy as np
+from common import run
 
-from articula.control.current_loop import CHANNELS, SUMS, _loop
-from articula.experiments.ch4 import (
+from articula.book.ch4.experiment import (
     CurrentControlConfig,
     current_reference,
     loop_settings,
@@ -32,6 +30,7 @@ from articula.experiments.ch4 import (
     simulate_batch,
     time_axis,
 )
+from articula.loops.motor_current import CHANNELS, SUMS, _loop
 from articula.plants.motor_rig import discretize, rig_matrices
 
 TRIALS = 1000
@@ -107,35 +106,22 @@ def measure() -> dict[str, object]:
     }
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--json", action="store_true", help="print one JSON object")
-    args = parser.parse_args()
-    m = measure()
-    if args.json:
-        print(json.dumps(m))
-        return
-    from rich.console import Console
-    from rich.table import Table
-
-    table = Table(title="chapter-4 current loop (1 kHz, dual rig, noisy sensor, 8-bit PWM)")
-    for col in ("measure", "value", "target"):
-        table.add_column(col)
-    table.add_row(
-        "realtime_factor (run_current_control, 20 s)", f"{m['realtime_factor']:.0f}", ">= 1000"
-    )
-    table.add_row("  compiled kernel only", f"{m['kernel_realtime_factor']:.0f}", "")
-    table.add_row(
-        "  baseline: same loop interpreted", f"{m['interpreted_realtime_factor']:.1f}", ""
-    )
-    table.add_row(f"{TRIALS} separate 1 s runs [s]", f"{m['separate_runs_s']:.3f}", "")
-    table.add_row(f"one batch of {TRIALS} × 1 s [s]", f"{m['batch_s']:.3f}", "")
-    table.add_row("  of which drawing the sensor noise [s]", f"{m['batch_noise_draw_s']:.3f}", "")
-    table.add_row("batch_speedup (1 s runs)", f"{m['batch_speedup']:.1f}", ">= 20")
-    for d, r in m["batch_speedup_by_duration"].items():
-        table.add_row(f"  batch speed-up, {d} s runs", f"{r:.1f}", "")
-    Console().print(table)
+def table(m: dict) -> tuple[str, list[str], list[list[str]]]:
+    """The measures as (title, columns, rows) for a person."""
+    rows = [
+        ["realtime_factor (run_current_control, 20 s)", f"{m['realtime_factor']:.0f}", ">= 1000"],
+        ["  compiled kernel only", f"{m['kernel_realtime_factor']:.0f}", ""],
+        ["  baseline: same loop interpreted", f"{m['interpreted_realtime_factor']:.1f}", ""],
+        [f"{TRIALS} separate 1 s runs [s]", f"{m['separate_runs_s']:.3f}", ""],
+        [f"one batch of {TRIALS} × 1 s [s]", f"{m['batch_s']:.3f}", ""],
+        ["  of which drawing the sensor noise [s]", f"{m['batch_noise_draw_s']:.3f}", ""],
+        ["batch_speedup (1 s runs)", f"{m['batch_speedup']:.1f}", ">= 20"],
+    ]
+    rows += [[f"  batch speed-up, {d} s runs", f"{r:.1f}", ""]
+             for d, r in m["batch_speedup_by_duration"].items()]  # fmt: skip
+    title = "chapter-4 current loop (1 kHz, dual rig, noisy sensor, 8-bit PWM)"
+    return title, ["measure", "value", "target"], rows
 
 
 if __name__ == "__main__":
-    main()
+    run(__doc__, measure, table)

@@ -3,8 +3,8 @@
     python benchmarks/pid_sweep.py [--json] [--workers N]
 
 full_sweep_s: wall time of the full Table 2.3 sweep, six controllers × seven frequencies ×
-25 trials = 1,050 closed-loop runs (42 batched sweep points), through `runner.run_sweep` into
-a fresh temporary folder with N local worker processes (default 2), gains from the book's
+25 trials = 1,050 closed-loop runs (42 batched sweep points), through `runs.runner.run_sweep`
+into a fresh temporary folder with N local worker processes (default 2), gains from the book's
 Table 2.2. Target <= 60 s on 2 cores.
 batch_speedup: wall time per trial of 25 trials run one by one (25 calls of the registered
 experiment with trials = 1 and seeds 0-24) divided by the same 25 trials as one batch (one
@@ -18,24 +18,26 @@ a figure that can keep growing.
 
 from __future__ import annotations
 
-import argparse
-import json
 import tempfile
 import time
 from pathlib import Path
 
-from articula.experiments import runner
-from articula.experiments.ch2 import (
+from common import run
+
+from articula.book.ch2.book_values import BOOK_TABLE_2_2, CONTROLLERS
+from articula.book.ch2.experiment import (
+    AngleReference,
     ControllerConfig,
     PneuNetPidConfig,
-    ReferenceConfig,
     run_pneunet_pid,
 )
-from articula.experiments.ch2_report import BOOK_TABLE_2_2, CONTROLLERS
+from articula.book.study import packaged
+from articula.runs.runner import run_sweep
+from articula.runs.sweep import expand_sweep
 from articula.validation import load_toml
 
 TRIALS = 25
-SWEEP = Path(__file__).parents[1] / "src/articula/experiments/configs/ch2/table2_3_full.toml"
+SWEEP = packaged("ch2", "table2_3_full.toml")
 
 
 def _book_controllers() -> list[dict[str, object]]:
@@ -58,10 +60,10 @@ def _book_controllers() -> list[dict[str, object]]:
 def _full_sweep_seconds(workers: int) -> tuple[float, int]:
     spec = load_toml(SWEEP)
     spec["grid"] = {"controller": _book_controllers()}
-    configs = runner.expand_sweep(spec)
+    configs = expand_sweep(spec)
     with tempfile.TemporaryDirectory() as tmp:
         start = time.perf_counter()
-        runner.run_sweep(configs, Path(tmp) / "sweep", workers=workers)
+        run_sweep(configs, Path(tmp) / "sweep", workers=workers)
         return time.perf_counter() - start, sum(c["trials"] for c in configs)
 
 
@@ -83,7 +85,7 @@ def _batch_speedup() -> tuple[float, float, float]:
     """(one by one [s], batch [s], ratio) for TRIALS trials of the 0.5 Hz fuzzy run."""
     rows = [BOOK_TABLE_2_2["auto"][k] for k in ("15", "45", "75")]
     config = PneuNetPidConfig(
-        trials=TRIALS, duration=10.0, reference=ReferenceConfig(frequency=0.5),
+        trials=TRIALS, duration=10.0, reference=AngleReference(frequency=0.5),
         controller=ControllerConfig(name="fuzzy-auto", schedule="fuzzy", gains=rows),
     )  # fmt: skip
     singles = [config.model_copy(update={"seed": s, "trials": 1}) for s in range(TRIALS)]
@@ -110,30 +112,23 @@ def measure(workers: int) -> dict[str, object]:
     }
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--json", action="store_true", help="print one JSON object")
-    parser.add_argument("--workers", type=int, default=2, help="local worker processes")
-    args = parser.parse_args()
-    m = measure(args.workers)
-    if args.json:
-        print(json.dumps(m))
-        return
-    from rich.console import Console
-    from rich.table import Table
-
-    table = Table(title="chapter-2 PID comparison (simulated PneuNet, 30 Hz loop)")
-    for col in ("measure", "value", "target"):
-        table.add_column(col)
-    table.add_row(
-        f"full_sweep_s ({m['full_sweep_runs']} closed-loop runs, {m['workers']} workers)",
-        f"{m['full_sweep_s']:.1f}", "<= 60",
-    )  # fmt: skip
-    table.add_row(f"{TRIALS} trials one by one, 10 s each [s]", f"{m['one_by_one_s']:.3f}", "")
-    table.add_row(f"one batch of {TRIALS} trials [s]", f"{m['batch_s']:.3f}", "")
-    table.add_row("batch_speedup", f"{m['batch_speedup']:.1f}", ">= 20")
-    Console().print(table)
+def table(m: dict) -> tuple[str, list[str], list[list[str]]]:
+    """The measures as (title, columns, rows) for a person."""
+    rows = [
+        [f"full_sweep_s ({m['full_sweep_runs']} closed-loop runs, {m['workers']} workers)",
+         f"{m['full_sweep_s']:.1f}", "<= 60"],
+        [f"{TRIALS} trials one by one, 10 s each [s]", f"{m['one_by_one_s']:.3f}", ""],
+        [f"one batch of {TRIALS} trials [s]", f"{m['batch_s']:.3f}", ""],
+        ["batch_speedup", f"{m['batch_speedup']:.1f}", ">= 20"],
+    ]  # fmt: skip
+    title = "chapter-2 PID comparison (simulated PneuNet, 30 Hz loop)"
+    return title, ["measure", "value", "target"], rows
 
 
 if __name__ == "__main__":
-    main()
+    run(
+        __doc__,
+        measure,
+        table,
+        workers={"type": int, "default": 2, "help": "local worker processes"},
+    )

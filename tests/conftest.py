@@ -107,3 +107,24 @@ def one_json() -> Callable[[str], dict[str, Any]]:
         return obj
 
     return parse
+
+
+@pytest.fixture
+def main_fails(capsys) -> Callable[..., str]:
+    """main_fails(*args) runs `articula.cli.main` in-process (the console script's code path,
+    without its start-up cost) and checks: SystemExit(2), nothing on stdout, one stderr line,
+    no traceback. Returns that line."""
+    from articula.cli import main
+
+    def run(*args: Any) -> str:
+        with pytest.raises(SystemExit) as exc:
+            main([str(a) for a in args])
+        assert exc.value.code == 2
+        captured = capsys.readouterr()
+        assert captured.out == ""
+        lines = captured.err.splitlines()
+        assert len(lines) == 1 and lines[0].strip(), captured.err
+        assert "Traceback" not in captured.err
+        return lines[0]
+
+    return run

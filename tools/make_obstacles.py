@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-OUT = Path(__file__).resolve().parents[1] / "src/articula/experiments/configs/ch1"
+OUT = Path(__file__).resolve().parents[1] / "src/articula/book/ch1/configs"
 
 
 def bracket() -> trimesh.Trimesh:

@@ -8,11 +8,8 @@ from articula.errors import (
     InfeasibleError,
     ModelError,
 )
-from articula.numba_cache import refresh_cache
 
 __version__ = "0.1.0"
-
-refresh_cache()  # before any compiled function loads its cache (see numba_cache.py)
 
 __all__ = [
     "ArticulaError",

@@ -26,7 +26,15 @@ class GeometryError(ArticulaError, ValueError):
 
 
 class InfeasibleError(ArticulaError, RuntimeError):
-    """A requested operating point or plan cannot be reached within the limits."""
+    """A requested operating point or plan cannot be reached within the limits.
+
+    `field`, when given, names the argument (or config key) whose value makes it infeasible.
+    """
+
+    def __init__(self, problem: str, field: str | None = None) -> None:
+        self.field = field
+        self.problem = problem
+        super().__init__(f"{field}: {problem}" if field else problem)
 
 
 class DeviceError(ArticulaError, OSError):

@@ -4,12 +4,19 @@ numba keys a cached function on its own file only, so a compiled function that c
 compiled function in another module keeps the callee's old code after that module changes
 (e.g. after `git pull` in an editable install). Before any compiled code loads, the package's
 cache files are removed whenever its compiled sources differ from those they were built from.
+Compiled modules decorate with `jit(...)`, which does that check once per process, when the
+first compiled module is imported: `import articula` alone reads no source file.
 """
 
 from __future__ import annotations
 
 import hashlib
+from collections.abc import Callable
+from functools import cache
 from pathlib import Path
+from typing import Any
+
+import numba
 
 PACKAGE = Path(__file__).resolve().parent
 STAMP = "numba-sources.sha256"
@@ -43,3 +50,15 @@ def refresh_cache(root: Path = PACKAGE) -> bool:
     except OSError:
         return False  # not writable: numba then caches in its user-wide folder
     return True
+
+
+@cache
+def _refresh_once() -> None:
+    """refresh_cache() for the installed package, at most once per process."""
+    refresh_cache()
+
+
+def jit(**options: Any) -> Callable[[Callable[..., Any]], Any]:
+    """numba.njit with an on-disk cache that never outlives its sources (and `options`)."""
+    _refresh_once()
+    return numba.njit(cache=True, **options)

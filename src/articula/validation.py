@@ -3,15 +3,20 @@
 from __future__ import annotations
 
 import tomllib
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Annotated, Any, TypeVar
 
-from pydantic import BaseModel, ConfigDict, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from articula.errors import ConfigError
+from articula.errors import ConfigError, InfeasibleError
 
 M = TypeVar("M", bound=BaseModel)
+# Field types shared by parameter models: finite floats, optionally bounded.
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 
 
 class StrictModel(BaseModel):
@@ -23,7 +28,8 @@ class StrictModel(BaseModel):
         try:
             super().__init__(**data)
         except ValidationError as exc:
-            raise config_error_from(exc, type(self).__name__) from None
+            # Built in code, not from a file: name the field as ClassName.field.
+            raise config_error_from(exc, owner=type(self).__name__) from None
 
 
 def field_error(name: str, problem: str) -> ConfigError:
@@ -42,8 +48,12 @@ def parse_model(model: type[M], data: Mapping[str, Any], where: str = "") -> M:
         raise config_error_from(exc, where) from None
 
 
-def config_error_from(exc: ValidationError, where: str = "") -> ConfigError:
-    """The first problem of a pydantic ValidationError as a ConfigError."""
+def config_error_from(exc: ValidationError, where: str = "", owner: str = "") -> ConfigError:
+    """The first problem of a pydantic ValidationError as a ConfigError.
+
+    `where` (a file name) prefixes the field's path as "where: a.b"; `owner` (a class name) as
+    "Owner.a.b".
+    """
     first = exc.errors()[0]
     loc = tuple(str(p) for p in first["loc"])
     inner = first.get("ctx", {}).get("error")
@@ -58,10 +68,26 @@ def config_error_from(exc: ValidationError, where: str = "") -> ConfigError:
         problem = str(first["msg"]).removeprefix("Value error, ")
         if loc:  # a check across fields has no loc, and its input is the whole table
             problem += f" (got {first.get('input')!r})"
-    path = ".".join(loc) or "config"
+    path = ".".join((owner, *loc) if owner else loc) or "config"
     error = ConfigError(f"{where}: {path}" if where else path, problem)
     error.loc = loc
     return error
+
+
+@contextmanager
+def fields_as(paths: Mapping[str, str]) -> Iterator[None]:
+    """Rename the field of a ConfigError or InfeasibleError raised inside, from the argument
+    name the library used to the config path the user wrote (e.g. "q0" -> "robot.q0")."""
+    try:
+        yield
+    except ConfigError as exc:
+        if exc.field not in paths:
+            raise
+        raise ConfigError(paths[exc.field], exc.problem) from None
+    except InfeasibleError as exc:
+        if exc.field not in paths:
+            raise
+        raise InfeasibleError(exc.problem, paths[exc.field]) from None
 
 
 def load_toml(path: Path) -> dict[str, Any]:

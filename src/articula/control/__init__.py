@@ -1,1 +1,2 @@
-"""Discrete controllers, filters and actuator models."""
+"""Controllers and their parts: PID with gain schedules, PWM, moving-average filter,
+chamber allocation and the damping policy."""

@@ -9,9 +9,7 @@ from pydantic import Field
 
 from articula.plants.six_chamber import CHAMBERS, SixChamberParams
 from articula.plants.six_chamber_sim import FILL, HOLD, VENT, fill_time
-from articula.validation import StrictModel
-
-NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+from articula.validation import NonNegative, StrictModel
 
 
 class DampingPolicy(StrictModel):

@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from articula.errors import ConfigError
+from articula.numba_cache import jit
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def moving_average_push(buffer: np.ndarray, n: int, samples: np.ndarray, means: np.ndarray) -> None:
     """Store sample number n of each column and write the mean of its last k samples.
 

@@ -44,24 +44,28 @@ class GainSchedule:
         object.__setattr__(self, "points", points)
         if gains.ndim != 2 or gains.shape[1] != 3 or not np.all(np.isfinite(gains)):
             raise ConfigError(
-                "gains", f"must be finite rows [kp, ki, kd] (got shape {gains.shape})"
+                "GainSchedule.gains", f"must be finite rows [kp, ki, kd] (got shape {gains.shape})"
             )
         if self.kind == "constant":
             if gains.shape[0] != 1:
                 raise ConfigError(
-                    "gains", f"a constant schedule has one row (got {gains.shape[0]})"
+                    "GainSchedule.gains", f"a constant schedule has one row (got {gains.shape[0]})"
                 )
             return
         if self.kind not in ("piecewise", "fuzzy"):
             raise ConfigError(
-                "kind", f"unknown schedule {self.kind!r}; use constant, piecewise or fuzzy"
+                "GainSchedule.kind",
+                f"unknown schedule {self.kind!r}; use constant, piecewise or fuzzy",
             )
         if points.shape != (gains.shape[0],):
             raise ConfigError(
-                "points", f"need one point per row of gains ({gains.shape[0]}), got {points.shape}"
+                "GainSchedule.points",
+                f"need one point per row of gains ({gains.shape[0]}), got {points.shape}",
             )
         if not np.all(np.isfinite(points)) or np.any(np.diff(points) <= 0):
-            raise ConfigError("points", f"must be finite and increasing (got {points.tolist()})")
+            raise ConfigError(
+                "GainSchedule.points", f"must be finite and increasing (got {points.tolist()})"
+            )
 
     @property
     def boundaries(self) -> np.ndarray:
@@ -94,9 +98,11 @@ class PID:
     ) -> None:
         lo, hi = output_limits
         if not lo < hi:
-            raise ConfigError("output_limits", f"need low < high (got {output_limits})")
+            raise ConfigError("PID.output_limits", f"need low < high (got {output_limits})")
         if not (np.isfinite(derivative_tau) and derivative_tau >= 0):
-            raise ConfigError("derivative_tau", f"must be finite and >= 0 (got {derivative_tau})")
+            raise ConfigError(
+                "PID.derivative_tau", f"must be finite and >= 0 (got {derivative_tau})"
+            )
         self.schedule = schedule
         self.output_limits = (float(lo), float(hi))
         self.derivative_tau = float(derivative_tau)
@@ -122,7 +128,7 @@ class PID:
             dt = t - self.last_time
             if not dt > 0:
                 raise ConfigError(
-                    "t", f"sample times must increase (got {self.last_time} then {t})"
+                    "PID.t", f"sample times must increase (got {self.last_time} then {t})"
                 )
             integral = self.integral + error * dt  # Σ_{i≤n} e[i] Δt_i, Eq. (2.2)
             raw = (error - self.last_error) / dt  # Δe_n / Δt_n, Eq. (2.2)

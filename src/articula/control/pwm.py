@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from articula.numba_cache import jit
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def pwm_counts(voltage: float, v_max: float, bits: int) -> int:
     """Signed duty register value S[n] for a commanded voltage [V], Eq. (4.15)."""
     magnitude = min(abs(voltage), v_max)  # Eq. (4.16), applied to |V|; the sign drives the H-bridge
@@ -17,13 +17,13 @@ def pwm_counts(voltage: float, v_max: float, bits: int) -> int:
     return counts if voltage >= 0 else -counts
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def pwm_voltage(counts: int, v_max: float, bits: int) -> float:
     """Mean voltage [V] the H-bridge applies for a signed duty register value."""
     return v_max * counts / (1 << bits)
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def saturate(voltage: float, v_max: float) -> float:
     """Voltage [V] clipped to the driver's range [−v_max, v_max], Eq. (4.16) on both signs."""
     return max(-v_max, min(v_max, voltage))

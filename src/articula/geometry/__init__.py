@@ -1,1 +1,2 @@
-"""Convex shapes, mesh loading, poses and signed distances (GJK/EPA through coal)."""
+"""Convex shapes (coal), mesh loading and convex decomposition (trimesh, CoACD), bounding
+capsules and poses. Distances between shapes live in `articula.scene`."""

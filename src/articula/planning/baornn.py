@@ -4,40 +4,41 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Annotated
 
 import numpy as np
+from pydantic import Field
 
-from articula.errors import ConfigError
 from articula.planning import baornn_kernel as kernel
 from articula.planning.objective import Objective
 from articula.scene.scene import Scene
+from articula.validation import Positive, StrictModel
 
 
-@dataclass(frozen=True)
-class BaornnParams:
-    """Antenna length λ_k = c1·√g_k (1.23) [rad], c1 in rad/√m, and step δ_k = c2·λ_k (1.24),
-    c2 dimensionless; iterations per control period."""
+class BaornnParams(StrictModel):
+    """Step constants of Algorithm 1.
 
-    c1: float = 0.5
-    c2: float = 0.5
-    iterations_per_step: int = 10
+    Attributes:
+        c1: antenna length λ_k = c1·√g_k, Eq. (1.23) [rad/√m].
+        c2: step δ_k = c2·λ_k, Eq. (1.24) [-].
+        iterations_per_step: iterations per control period.
+    """
 
-    def __post_init__(self) -> None:
-        check_step_constants(self.c1, self.c2, self.iterations_per_step)
-
-
-def check_step_constants(c1: float, c2: float, iterations_per_step: int) -> None:
-    """ConfigError unless c1, c2 are finite and > 0 and there is at least one iteration."""
-    if not (np.isfinite(c1) and c1 > 0 and np.isfinite(c2) and c2 > 0):
-        raise ConfigError("planner.c1/c2", f"must be finite and > 0 (got {c1}, {c2})")
-    if iterations_per_step < 1:
-        raise ConfigError("planner.iterations_per_step", "must be >= 1")
+    c1: Positive = 0.5
+    c2: Positive = 0.5
+    iterations_per_step: Annotated[int, Field(ge=1)] = 10
 
 
-class OnObjective:
-    """The Planner properties of a planner that searches an Objective."""
+@dataclass
+class BeetleSearch:
+    """What both BAORNN variants hold: the objective they search, their step constants, the
+    generator of all their randomness, and counts of objective evaluations and iterations."""
 
     objective: Objective
+    params: BaornnParams
+    rng: np.random.Generator
+    evaluations: int = field(default=0, init=False)
+    iterations: int = field(default=0, init=False)
 
     @property
     def scene(self) -> Scene:
@@ -50,15 +51,8 @@ class OnObjective:
         return self.objective.d_min
 
 
-@dataclass
-class Baornn(OnObjective):
+class Baornn(BeetleSearch):
     """The faithful algorithm of Sect. 1.3.1; all randomness from the injected generator."""
-
-    objective: Objective
-    params: BaornnParams
-    rng: np.random.Generator
-    evaluations: int = field(default=0, init=False)
-    iterations: int = field(default=0, init=False)
 
     def iterate(
         self, q: np.ndarray, g: float, x_ref: np.ndarray, t: float

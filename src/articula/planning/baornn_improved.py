@@ -14,39 +14,27 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Annotated
 
 import numpy as np
+from pydantic import Field
 
-from articula.errors import ConfigError
 from articula.planning import baornn_kernel as kernel
-from articula.planning.baornn import OnObjective, check_step_constants
-from articula.planning.objective import Objective
+from articula.planning.baornn import BaornnParams, BeetleSearch
 
 
-@dataclass(frozen=True)
-class ImprovedParams:
-    """λ_k = c1·√e_k, δ_k = c2·λ_k; antenna pairs per iteration; iterations per period."""
+class ImprovedParams(BaornnParams):
+    """BaornnParams with λ_k = c1·√e_k [rad/√m] instead of (1.23), and `pairs`, the antenna
+    pairs per iteration."""
 
-    c1: float = 0.5
-    c2: float = 0.5
-    pairs: int = 3
-    iterations_per_step: int = 10
-
-    def __post_init__(self) -> None:
-        check_step_constants(self.c1, self.c2, self.iterations_per_step)
-        if self.pairs < 1:
-            raise ConfigError("planner.pairs", "must be >= 1")
+    pairs: Annotated[int, Field(ge=1)] = 3
 
 
 @dataclass
-class ImprovedBaornn(OnObjective):
+class ImprovedBaornn(BeetleSearch):
     """Algorithm 1 with the changes above; the same objective, projection and acceptance."""
 
-    objective: Objective
     params: ImprovedParams
-    rng: np.random.Generator
-    evaluations: int = field(default=0, init=False)
-    iterations: int = field(default=0, init=False)
     _last_motion: np.ndarray | None = field(default=None, init=False)
 
     def iterate(

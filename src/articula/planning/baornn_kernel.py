@@ -9,12 +9,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from articula.numba_cache import jit
 from articula.scene.compiled_clearance import _evaluate
 
 
-@njit(cache=True)
+@jit()
 def _project_and_value(
     q, q_current, g_current, x_ref, lambda_weight, beta, d_min, use_distance, lower, upper,
     arrays, static_min,
@@ -33,7 +33,7 @@ def _project_and_value(
     return clipped, g
 
 
-@njit(cache=True)
+@jit()
 def iterations(
     q, g, x_ref, directions, c1, c2, lambda_weight, beta, d_min, use_distance, lower, upper,
     arrays, static_min,
@@ -60,7 +60,7 @@ def iterations(
     return q, g
 
 
-@njit(cache=True)
+@jit()
 def improved_iterations(
     q, g, x_ref, draws, c1, c2, lambda_weight, beta, d_min, use_distance, lower, upper,
     arrays, kinematics, static_min,

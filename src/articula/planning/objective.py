@@ -36,7 +36,7 @@ class Objective:
         for name in ("lambda_weight", "beta", "d_min"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
-                raise ConfigError(f"planner.{name}", f"must be finite and >= 0 (got {value})")
+                raise ConfigError(f"Objective.{name}", f"must be finite and >= 0 (got {value})")
         if self.use_compiled:
             object.__setattr__(self, "compiled", CompiledClearance.build(self.scene))
 

@@ -7,42 +7,40 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import qpsolvers
+from pydantic import model_validator
 
-from articula.errors import ConfigError
 from articula.planning.clearance import clearance_rows
-from articula.planning.reference_velocity import reference_velocity
+from articula.planning.reference_velocity import RateParams, reference_velocity
 from articula.scene.scene import Scene
+from articula.validation import NonNegative, field_error
 
 
-@dataclass(frozen=True)
-class QpIkParams:
+class QpIkParams(RateParams):
     """min ½ λ_q |q̇|² + ½ λ_δ |δ|² s.t. J q̇ + δ = ẋ_r + K e, dampers, speed bounds.
 
-    gain K [1/s]; joint_weight λ_q and slack_weight λ_δ; damper gain ξ [m/s or rad/s];
-    influence d_i and safety d_s distances [m] (ḋ ≥ −ξ (d − d_s)/(d_i − d_s) for d < d_i);
-    limit_influence and limit_safety [rad] the same damper on the distance to each joint
-    limit; speed_scale scales the URDF joint velocity limits.
+    Attributes (besides RateParams'):
+        joint_weight: λ_q [-]; slack_weight: λ_δ [-].
+        damper_gain: ξ [m/s] (rad/s for joint limits).
+        safety: d_s [m]; with influence d_i, ḋ ≥ −ξ (d − d_s)/(d_i − d_s) for d < d_i.
+        limit_influence, limit_safety: the same damper on the distance to each joint limit [rad].
     """
 
-    gain: float = 20.0
-    joint_weight: float = 0.01
-    slack_weight: float = 100.0
-    damper_gain: float = 1.0
-    influence: float = 0.15
-    safety: float = 0.03
-    limit_influence: float = 0.2
-    limit_safety: float = 0.02
-    speed_scale: float = 1.0
+    joint_weight: NonNegative = 0.01
+    slack_weight: NonNegative = 100.0
+    damper_gain: NonNegative = 1.0
+    safety: NonNegative = 0.03
+    limit_influence: NonNegative = 0.2
+    limit_safety: NonNegative = 0.02
 
-    def __post_init__(self) -> None:
-        for name in self.__dataclass_fields__:
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value >= 0):
-                raise ConfigError(f"planner.{name}", f"must be finite and >= 0 (got {value})")
-        if self.speed_scale <= 0:
-            raise ConfigError("planner.speed_scale", "must be > 0 (a fraction of the URDF limits)")
-        if self.safety >= self.influence or self.limit_safety >= self.limit_influence:
-            raise ConfigError("planner.safety", "must be smaller than its influence distance")
+    @model_validator(mode="after")
+    def _safety_inside_influence(self) -> QpIkParams:
+        if self.safety >= self.influence:
+            raise field_error("safety", f"must be smaller than influence = {self.influence} m")
+        if self.limit_safety >= self.limit_influence:
+            raise field_error(
+                "limit_safety", f"must be smaller than limit_influence = {self.limit_influence} rad"
+            )
+        return self
 
 
 @dataclass

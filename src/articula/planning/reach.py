@@ -41,7 +41,8 @@ def check_reach(
         distance = float(np.linalg.norm(trajectory(t) - centre))
         if distance > radius:
             raise InfeasibleError(
-                f"trajectory: unreachable: at t = {t:.2f} s the path is {distance:.3f} m from "
-                f"the first joint, beyond the arm's reach of {radius:.3f} m (the error cannot "
-                f"fall below {distance - radius:.3g} m)"
+                f"unreachable: at t = {t:.2f} s the path is {distance:.3f} m from the first "
+                f"joint, beyond the arm's reach of {radius:.3f} m (the error cannot fall below "
+                f"{distance - radius:.3g} m)",
+                "trajectory",
             )

@@ -4,6 +4,22 @@ from __future__ import annotations
 
 import numpy as np
 
+from articula.validation import NonNegative, Positive, StrictModel
+
+
+class RateParams(StrictModel):
+    """What every resolved-rate baseline takes.
+
+    Attributes:
+        gain: K on the position error [1/s].
+        influence: the distance below which an obstacle counts [m].
+        speed_scale: fraction of the URDF joint velocity limits [-].
+    """
+
+    gain: NonNegative = 20.0
+    influence: NonNegative = 0.15
+    speed_scale: Positive = 1.0
+
 
 def reference_velocity(
     x_ref: np.ndarray, previous_ref: np.ndarray | None, x: np.ndarray, dt: float, gain: float

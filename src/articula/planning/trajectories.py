@@ -40,13 +40,13 @@ class Circle:
         radius: float, period: float,
     ) -> Circle:  # fmt: skip
         """A validated circle: A and B must be perpendicular unit vectors."""
-        a = _vector("trajectory.axis_a", axis_a, (3,))
-        b = _vector("trajectory.axis_b", axis_b, (3,))
+        a = _vector("axis_a", axis_a, (3,))
+        b = _vector("axis_b", axis_b, (3,))
         if not (np.isclose(a @ a, 1) and np.isclose(b @ b, 1) and abs(a @ b) < 1e-9):
-            raise ConfigError("trajectory.axis_a/axis_b", "must be perpendicular unit vectors")
-        center_ = _vector("trajectory.center", center, (3,))
-        radius_ = _positive("trajectory.radius", radius)
-        return cls(center_, a, b, radius_, _positive("trajectory.period", period))
+            raise ConfigError("axis_b", "axis_a and axis_b must be perpendicular unit vectors")
+        center_ = _vector("center", center, (3,))
+        radius_ = _positive("radius", radius)
+        return cls(center_, a, b, radius_, _positive("period", period))
 
     def __call__(self, t: float) -> np.ndarray:
         """Reference point [m] at time t [s]."""
@@ -69,27 +69,27 @@ class Waypoints:
         p = np.asarray(points, dtype=float)
         t = np.asarray(times, dtype=float)
         if p.ndim != 2 or p.shape[1] != 3 or len(p) < 2:
-            raise ConfigError("trajectory.points", f"needs two or more [x, y, z] (got {p.shape})")
+            raise ConfigError("points", f"needs two or more [x, y, z] (got {p.shape})")
         if t.shape != (len(p),):
-            raise ConfigError("trajectory.times", f"needs {len(p)} times, one per point")
+            raise ConfigError("times", f"needs {len(p)} times, one per point")
         if not (np.all(np.isfinite(p)) and np.all(np.isfinite(t))):
-            raise ConfigError("trajectory", "points and times must be finite numbers")
+            raise ConfigError("points", "points and times must be finite numbers")
         if np.any(np.diff(t) <= 0):
-            raise ConfigError("trajectory.times", "must be strictly increasing")
+            raise ConfigError("times", "must be strictly increasing")
         return cls(p, t)
 
     @classmethod
     def from_csv(cls, path: Path) -> Waypoints:
         """Waypoints from a CSV file with the header t,x,y,z."""
         if not Path(path).is_file():
-            raise ConfigError("trajectory.path", f"{path}: file not found")
+            raise ConfigError("path", f"{path}: file not found")
         try:
             data = np.genfromtxt(path, delimiter=",", names=True)
         except ValueError as exc:
-            raise ConfigError("trajectory.path", f"{path}: not a numeric CSV ({exc})") from None
+            raise ConfigError("path", f"{path}: not a numeric CSV ({exc})") from None
         names = data.dtype.names or ()
         if set(names) != {"t", "x", "y", "z"}:
-            raise ConfigError("trajectory.path", f"{path}: needs columns t, x, y, z (got {names})")
+            raise ConfigError("path", f"{path}: needs columns t, x, y, z (got {names})")
         data = np.atleast_1d(data)
         return cls.create(np.column_stack([data["x"], data["y"], data["z"]]), data["t"])
 
@@ -100,11 +100,11 @@ class Waypoints:
 
 def rectangle(vertices: Sequence[Sequence[float]], period: float) -> Waypoints:
     """The closed path through four vertices at constant speed, once per `period` [s]."""
-    v = _vector("trajectory.vertices", vertices, (4, 3))
-    T = _positive("trajectory.period", period)
+    v = _vector("vertices", vertices, (4, 3))
+    T = _positive("period", period)
     loop = np.vstack([v, v[:1]])
     lengths = np.linalg.norm(np.diff(loop, axis=0), axis=1)
     if np.any(lengths <= 0):
-        raise ConfigError("trajectory.vertices", "consecutive vertices must differ")
+        raise ConfigError("vertices", "consecutive vertices must differ")
     times = np.concatenate([[0.0], np.cumsum(lengths)]) / lengths.sum() * T
     return Waypoints.create(loop, times)

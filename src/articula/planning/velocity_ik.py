@@ -8,37 +8,25 @@ from typing import Literal
 
 import numpy as np
 
-from articula.errors import ConfigError
 from articula.planning.clearance import clearance_rows
-from articula.planning.reference_velocity import reference_velocity
+from articula.planning.reference_velocity import RateParams, reference_velocity
 from articula.scene.scene import Scene
+from articula.validation import NonNegative
 
 PINV_CUTOFF = 1e-6
 
 
-@dataclass(frozen=True)
-class VelocityIkParams:
+class VelocityIkParams(RateParams):
     """Gains of q̇ = J#(ẋ_r + K e) + (I − J⁺J) q̇_0.
 
-    gain K [1/s] on the position error; damping μ [m] of DLS, J# = Jᵀ(JJᵀ + μ²I)⁻¹;
-    repulsion η [m²/s] and influence distance [m] of the null-space term
-    q̇_0 = η Σ (1/d − 1/d_i)/d² ∇d (the gradient of the classic FIRAS potential); speed_scale
-    scales the URDF joint velocity limits.
+    Attributes (besides RateParams'; `influence` is d_i, beyond which nothing repels):
+        damping: μ of DLS, J# = Jᵀ(JJᵀ + μ²I)⁻¹ [m].
+        repulsion: η of the null-space term q̇_0 = η Σ (1/d − 1/d_i)/d² ∇d, the gradient of
+            the classic FIRAS potential [m²/s].
     """
 
-    gain: float = 20.0
-    damping: float = 0.02
-    repulsion: float = 0.02
-    influence: float = 0.15
-    speed_scale: float = 1.0
-
-    def __post_init__(self) -> None:
-        for name in ("gain", "damping", "repulsion", "influence", "speed_scale"):
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value >= 0):
-                raise ConfigError(f"planner.{name}", f"must be finite and >= 0 (got {value})")
-        if self.speed_scale <= 0:
-            raise ConfigError("planner.speed_scale", "must be > 0 (a fraction of the URDF limits)")
+    damping: NonNegative = 0.02
+    repulsion: NonNegative = 0.02
 
 
 @dataclass

@@ -2,16 +2,10 @@
 
 from __future__ import annotations
 
-from typing import Annotated
-
 import numpy as np
-from pydantic import Field
 
 from articula.errors import InfeasibleError
-from articula.validation import StrictModel
-
-Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
-NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+from articula.validation import NonNegative, Positive, StrictModel
 
 # The book gives no armature inductance; 10 mH is typical of a 12 V gear-motor with
 # R ≈ 8 Ω and keeps the book's K_p = 10 current loop stable at 1 kHz (docs/deviations.md).

@@ -5,9 +5,9 @@ from __future__ import annotations
 import math
 from typing import Annotated
 
-from numba import njit
 from pydantic import Field, model_validator
 
+from articula.numba_cache import jit
 from articula.validation import StrictModel
 
 PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
@@ -45,7 +45,7 @@ class EncoderParams(StrictModel):
     window: Annotated[int, Field(ge=1, le=100_000)] = 50  # samples (50 ms at 1 kHz)
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def read_current(
     current: float,
     noise: float,
@@ -63,7 +63,7 @@ def read_current(
     return ((code + 0.5) * adc_vref / levels - zero_voltage) / sensitivity
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def encoder_count(theta: float, counts_per_rev: int) -> int:
     """Integer count of an incremental encoder at shaft angle θ [rad]."""
     return math.floor(theta * counts_per_rev / (2.0 * math.pi))

@@ -20,10 +20,7 @@ from pydantic import Field, model_validator
 from scipy.linalg import expm
 
 from articula.errors import ConfigError
-from articula.validation import StrictModel, field_error
-
-Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
-NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+from articula.validation import NonNegative, Positive, StrictModel, field_error
 
 
 class PneuNetParams(StrictModel):

@@ -16,10 +16,8 @@ from typing import Annotated
 import numpy as np
 from pydantic import Field, model_validator
 
-from articula.validation import StrictModel, field_error
+from articula.validation import NonNegative, Positive, StrictModel, field_error
 
-Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
-NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 CHAMBERS = 6
 GAS_CONSTANT = 287.05  # specific gas constant of air [J/(kg·K)]
 # Dragon Skin 30 datasheet: 100 % modulus 86 psi; kept to compare with the calibrated E.

@@ -1,4 +1,4 @@
-"""Time simulation of the six-chamber actuator with its 3/3 valves (compiled with numba).
+"""The six-chamber actuator with its 3/3 valves integrated over time (compiled with numba).
 
 State: β (2) [rad], β' (2) [rad/s] and the six absolute chamber pressures [Pa]. Each chamber's
 air obeys dp/dt = n/V (R T ṁ − p dV/dt) with V = V_0 + a_i·β, so a closed (holding) chamber is
@@ -15,9 +15,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
 from articula.errors import ConfigError
+from articula.numba_cache import jit
 from articula.plants.six_chamber import CHAMBERS, GAS_CONSTANT, SixChamberParams, volume_gradients
 
 VENT, HOLD, FILL = 0, 1, 2  # the three positions of each 3-port 3-position valve
@@ -90,7 +90,7 @@ def _constants(p: SixChamberParams) -> np.ndarray:
     ])  # fmt: skip
 
 
-def simulate(
+def integrate(
     p: SixChamberParams,
     schedule: ValveSchedule,
     duration: float,
@@ -127,7 +127,7 @@ def simulate(
     return Simulation(t, y[:, 0:2], y[:, 2:4], y[:, 4:] - p.atmosphere, m)
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def orifice_flow(upstream: float, downstream: float, rt: float, cda: float, trans: float) -> float:
     """Mass flow [kg/s] through an orifice, sharp-edged above `trans` [Pa], linear below."""
     dp = upstream - downstream
@@ -135,7 +135,7 @@ def orifice_flow(upstream: float, downstream: float, rt: float, cda: float, tran
     return cda * math.sqrt(2.0 * rho) * dp / (dp * dp + trans * trans) ** 0.25
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def _rhs(
     y: np.ndarray, modes: np.ndarray, targets: np.ndarray, c: np.ndarray, a: np.ndarray
 ) -> np.ndarray:
@@ -168,7 +168,7 @@ def _rhs(
     return dy
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def _integrate(
     y0: np.ndarray, modes: np.ndarray, c: np.ndarray, a: np.ndarray, ev_t: np.ndarray,
     ev_c: np.ndarray, ev_m: np.ndarray, ev_p: np.ndarray, dt: float, steps: int, every: int,
@@ -215,7 +215,7 @@ def fill_time(p: SixChamberParams, gauge: float, dt: float = 1e-5) -> float:
     return float(_fill_time(_constants(p), p.atmosphere + gauge, dt))
 
 
-@njit(cache=True, error_model="numpy")
+@jit(error_model="numpy")
 def _fill_time(c: np.ndarray, target: float, dt: float) -> float:
     v0, n, rt, cda, trans, p_atm, p_sup = c[3], c[4], c[5], c[6], c[7], c[8], c[9]
     p = p_atm

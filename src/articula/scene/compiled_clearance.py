@@ -16,10 +16,10 @@ from typing import ClassVar
 
 import numpy as np
 import pinocchio as pin
-from numba import njit
 from scipy.spatial import ConvexHull
 
 from articula.geometry.shapes import ConvexShape
+from articula.numba_cache import jit
 from articula.scene.gjk import gjk_distance
 from articula.scene.scene import Scene
 
@@ -181,7 +181,7 @@ def _capsule_ends(shape: ConvexShape) -> tuple[np.ndarray, np.ndarray, float]:
     return T[:3, 3] - half * T[:3, 2], T[:3, 3] + half * T[:3, 2], shape.bound.radius
 
 
-@njit(cache=True)
+@jit()
 def _compose(
     R1: np.ndarray, p1: np.ndarray, R2: np.ndarray, p2: np.ndarray, R: np.ndarray, p: np.ndarray
 ) -> None:
@@ -192,7 +192,7 @@ def _compose(
             R[i, k] = R1[i, 0] * R2[0, k] + R1[i, 1] * R2[1, k] + R1[i, 2] * R2[2, k]
 
 
-@njit(cache=True)
+@jit()
 def _rotate_about(R: np.ndarray, axis: np.ndarray, angle: float, out: np.ndarray) -> None:
     """out = R · Rot(axis, angle) (Rodrigues), axis a unit vector."""
     c, s = np.cos(angle), np.sin(angle)
@@ -208,14 +208,14 @@ def _rotate_about(R: np.ndarray, axis: np.ndarray, angle: float, out: np.ndarray
         out[i, 2] = a * r02 + b * r12 + d * r22
 
 
-@njit(cache=True)
+@jit()
 def _apply(R: np.ndarray, p: np.ndarray, x: np.ndarray, out: np.ndarray) -> None:
     """out = R x + p."""
     for i in range(3):
         out[i] = R[i, 0] * x[0] + R[i, 1] * x[1] + R[i, 2] * x[2] + p[i]
 
 
-@njit(cache=True)
+@jit()
 def _segment_distance(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> float:
     """Distance between segments [p1, q1] and [p2, q2] (Ericson, Sect. 5.1.9), in scalars."""
     d1x, d1y, d1z = q1[0] - p1[0], q1[1] - p1[1], q1[2] - p1[2]
@@ -248,7 +248,7 @@ def _segment_distance(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.nda
     return np.sqrt(gx * gx + gy * gy + gz * gz)
 
 
-@njit(cache=True)
+@jit()
 def _evaluate(
     q, parents, joint_rot, joint_p, axes, q_index, ee_joint, ee_p, vertices, starts,
     neighbours, offsets, hints, guesses, radii, shape_joint, shape_rot, shape_p, capsule_a,

@@ -15,10 +15,8 @@ from articula.geometry.shapes import ConvexShape, box, capsule, cylinder, sphere
 from articula.robots.model import RobotModel
 from articula.scene.obstacles import Obstacle
 from articula.scene.scene import Metric, Scene
-from articula.validation import StrictModel, parse_model
+from articula.validation import Finite, Positive, StrictModel, parse_model
 
-Finite = Annotated[float, Field(allow_inf_nan=False)]
-Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 Vec3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
 PositiveVec3 = Annotated[list[Positive], Field(min_length=3, max_length=3)]
 PositivePair = Annotated[list[Positive], Field(min_length=2, max_length=2)]

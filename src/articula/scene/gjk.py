@@ -11,18 +11,19 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from articula.numba_cache import jit
 
 _MAX_ITERATIONS = 64
 _RELATIVE_TOLERANCE = 1e-12  # stop when |v|² − v·w <= tol·|v|² (Gilbert et al. 1988)
 
 
-@njit(cache=True)
+@jit()
 def _dot(a: np.ndarray, b: np.ndarray) -> float:
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-@njit(cache=True)
+@jit()
 def _support(
     vertices: np.ndarray, neighbours: np.ndarray, offsets: np.ndarray, hint: int,
     R: np.ndarray, p: np.ndarray, dx: float, dy: float, dz: float, out: np.ndarray, sign: float,
@@ -57,14 +58,14 @@ def _support(
     return k
 
 
-@njit(cache=True)
+@jit()
 def _point_on(W: np.ndarray, i: int, j: int, t: float, out: np.ndarray) -> None:
     """out = W[i] + t (W[j] − W[i])."""
     for k in range(3):
         out[k] = W[i, k] + t * (W[j, k] - W[i, k])
 
 
-@njit(cache=True)
+@jit()
 def _closest_on_triangle(
     W: np.ndarray, ia: int, ib: int, ic: int, keep: np.ndarray, out: np.ndarray
 ) -> None:
@@ -126,7 +127,7 @@ def _closest_on_triangle(
         out[k] = W[ia, k] + v * (W[ib, k] - W[ia, k]) + w * (W[ic, k] - W[ia, k])
 
 
-@njit(cache=True)
+@jit()
 def _reduce(W: np.ndarray, n: int, keep: np.ndarray) -> int:
     """Keep only the flagged simplex vertices, packed at the front; returns their count."""
     m = 0
@@ -138,7 +139,7 @@ def _reduce(W: np.ndarray, n: int, keep: np.ndarray) -> int:
     return m
 
 
-@njit(cache=True)
+@jit()
 def _beyond_face(W: np.ndarray, ia: int, ib: int, ic: int, iopp: int) -> bool:
     """True if the origin and W[iopp] are on opposite sides of face (ia, ib, ic), or the
     tetrahedron is flat there (then every face is a candidate)."""
@@ -152,7 +153,7 @@ def _beyond_face(W: np.ndarray, ia: int, ib: int, ic: int, iopp: int) -> bool:
     return flat or side_origin * side_opposite < 0.0
 
 
-@njit(cache=True)
+@jit()
 def _closest_on_simplex(
     W: np.ndarray, n: int, keep: np.ndarray, best_keep: np.ndarray, trial: np.ndarray,
     out: np.ndarray,
@@ -204,7 +205,7 @@ def _closest_on_simplex(
     return _reduce(W, 4, keep)
 
 
-@njit(cache=True)
+@jit()
 def gjk_distance(
     vertices: np.ndarray, neighbours: np.ndarray, offsets: np.ndarray, hints: np.ndarray,
     a: int, R_a: np.ndarray, p_a: np.ndarray, radius_a: float,

@@ -15,7 +15,7 @@ import numpy as np
 
 from articula.errors import ConfigError, InfeasibleError
 from articula.tuning.response import (
-    Experiment,
+    GainExperiment,
     Response,
     StepFeatures,
     readonly,
@@ -83,7 +83,7 @@ class ManualSettings:
 
 
 def manual_tuning(
-    experiment: Experiment, settings: ManualSettings = ManualSettings()
+    experiment: GainExperiment, settings: ManualSettings = ManualSettings()
 ) -> ManualResult:
     """Sect. 2.3.2.1 scripted: K_p to converging swings, K_i to zero error, K_d for overshoot.
 
@@ -188,7 +188,7 @@ def ziegler_nichols(ku: float, tu: float, rule: ZnRule = "PID") -> np.ndarray:
 
 
 def ultimate_gain(
-    experiment: Experiment, ladder: Ladder, band: float, sustained: float = 0.8
+    experiment: GainExperiment, ladder: Ladder, band: float, sustained: float = 0.8
 ) -> tuple[float, float, list[Trial]]:
     """(K_u, T_u, experiments): the first P-only gain whose swings keep `sustained` of size."""
     trials: list[Trial] = []

@@ -1,7 +1,7 @@
 """One experiment's response as a tuner sees it, and the step-response features it decides on.
 
-A tuner needs only `Experiment`: run one experiment with gains K = [K_p, K_i, K_d] and return
-its `Response`. A simulated actuator and a real rig both fit.
+A tuner needs only a `GainExperiment`: run one experiment with gains K = [K_p, K_i, K_d] and
+return its `Response`. A simulated actuator and a real rig both fit.
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ class Response:
             object.__setattr__(self, name, readonly(getattr(self, name)))
 
 
-Experiment = Callable[[np.ndarray], Response]
+GainExperiment = Callable[[np.ndarray], Response]
 
 
 def tracking_error(reference: np.ndarray, measured: np.ndarray) -> np.ndarray:

@@ -1,0 +1,113 @@
+"""The planning experiment `baornn.plan`: a scene, a reference path and a planner, tracked.
+
+A plan config is a scene file ([robot], [[obstacles]]) with a [trajectory] and a [planner]
+table, and optionally `experiment = "baornn.plan"` and a top-level `seed`. `articula plan
+SCENE.toml` and `articula run CONFIG.toml` both run it through the shared runner, so a plan
+folder's config.toml re-runs and sweeps like any other experiment's.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+from pydantic import Field, model_validator
+
+from articula.errors import ConfigError, InfeasibleError
+from articula.loops.tracking import trace_columns, track, tracking_metrics
+from articula.planning.config import PlannerSpec, TrajectorySpec, make_planner, make_trajectory
+from articula.planning.reach import check_reach
+from articula.runs.registry import Experiment, Result
+from articula.scene.config import SceneSpec, build_scene, resolve_path
+from articula.validation import fields_as, load_toml
+
+NAME = "baornn.plan"
+# Library argument names -> where the user wrote them in a plan config.
+_CONFIG_PATHS = {"q0": "robot.q0", "dt": "planner.dt", "duration": "planner.duration"}
+
+
+class PlanConfig(SceneSpec):
+    """A scene with the path to track and the planner that tracks it.
+
+    `seed` seeds the planner's randomness; when absent, `planner.seed` (the form of scene
+    files), else 0. The validated config holds it once, at the top.
+    """
+
+    seed: Annotated[int, Field(ge=0)] | None = None
+    trajectory: TrajectorySpec
+    planner: PlannerSpec = PlannerSpec()
+
+    @model_validator(mode="after")
+    def _one_seed(self) -> PlanConfig:
+        seed = self.seed if self.seed is not None else self.planner.seed
+        object.__setattr__(self, "seed", 0 if seed is None else seed)
+        object.__setattr__(self, "planner", self.planner.model_copy(update={"seed": None}))
+        return self
+
+
+def run_plan(config: PlanConfig) -> Result:
+    """Track the path; metrics of loops.tracking.tracking_metrics and its trace columns.
+
+    Relative file paths start at the working folder (a config read from a file has them made
+    absolute by `absolute_paths`). Raises InfeasibleError for a path out of reach or tracked
+    worse than `planner.tolerance`.
+    """
+    base = Path.cwd()
+    scene, q0 = build_scene(config, base)
+    trajectory = make_trajectory(config.trajectory, base)
+    p = config.planner
+    with fields_as(_CONFIG_PATHS):
+        check_reach(scene.robot, trajectory, p.duration)
+        planner = make_planner(p, scene, config.seed or 0)
+        run = track(planner, trajectory, q0, p.dt, p.duration)
+    metrics = tracking_metrics(run, scene.robot, p.settle or 0.0, planner.iterations)
+    if metrics["rms_error"] > p.tolerance:
+        raise InfeasibleError(
+            f"not tracked: rms error {metrics['rms_error']:.3g} m after {p.settle} s (max "
+            f"{metrics['max_error']:.3g} m) exceeds planner.tolerance = {p.tolerance} m; the "
+            "path may be out of reach or blocked",
+            "trajectory",
+        )
+    return Result(metrics, trace_columns(run))
+
+
+def absolute_paths(data: dict[str, Any], base_dir: Path) -> dict[str, Any]:
+    """The config with its URDF, package folders, obstacle meshes and trajectory CSV made
+    absolute from `base_dir`, so that a run folder's config.toml still finds them."""
+
+    def absolute(path: Any) -> Any:
+        return str(resolve_path(base_dir, path).resolve()) if isinstance(path, str) else path
+
+    out = dict(data)
+    if isinstance(data.get("robot"), dict):
+        robot = dict(data["robot"])
+        if "urdf" in robot:
+            robot["urdf"] = absolute(robot["urdf"])
+        if isinstance(robot.get("package_dirs"), list):
+            robot["package_dirs"] = [absolute(d) for d in robot["package_dirs"]]
+        out["robot"] = robot
+    if isinstance(data.get("obstacles"), list):
+        out["obstacles"] = [
+            {**o, "mesh": absolute(o["mesh"])} if isinstance(o, dict) and "mesh" in o else o
+            for o in data["obstacles"]
+        ]
+    trajectory = data.get("trajectory")
+    if isinstance(trajectory, dict) and "path" in trajectory:
+        out["trajectory"] = {**trajectory, "path": absolute(trajectory["path"])}
+    return out
+
+
+def load_plan(path: Path) -> dict[str, Any]:
+    """A scene file (or a plan folder's config.toml) as a `baornn.plan` config, its file paths
+    made absolute."""
+    data = load_toml(path)
+    name = data.setdefault("experiment", NAME)
+    if name != NAME:
+        raise ConfigError(
+            f"{path}: experiment",
+            f"plan runs {NAME} configs (got {name!r}); run this file with `articula run`",
+        )
+    return absolute_paths(data, path.parent)
+
+
+PLAN = Experiment(NAME, PlanConfig, run_plan, absolute_paths)

@@ -1,0 +1,154 @@
+"""Chapter 2 tuning runs on the simulated PneuNet: the manual procedure and coordinate descent.
+
+Each evaluation of M (2.5) is one step experiment from rest on the simulated rig (fresh sensor
+noise every time), so the tuners see exactly what they would see on a real rig.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Annotated
+
+import numpy as np
+from pydantic import Field
+
+from articula.book.ch2.experiment import AngleReference, reference_deg
+from articula.control.pid import PID, GainSchedule
+from articula.loops.pneunet_pid import SimulatedRig, run_closed_loop
+from articula.plants.pneunet import PneuNetParams
+from articula.tuning.coordinate_descent import DescentResult, coordinate_descent
+from articula.tuning.manual import ManualResult, ManualSettings, manual_tuning
+from articula.tuning.response import Response, readonly, step_features, tuning_cost
+from articula.validation import Positive, StrictModel
+
+GainVector = Annotated[list[Positive], Field(min_length=3, max_length=3)]
+SUBRANGES = (15.0, 45.0, 75.0)  # representative points of [0,30), [30,60), [60,90] (Sect. 2.4.2.1)
+SEQUENCE = (15.0, 45.0, 75.0, 90.0)  # whole-range tuning sequence (Fig. 2.6a)
+
+
+class ManualConfig(StrictModel):
+    """The scripted manual procedure: one step experiment per trial, `hold` seconds long."""
+
+    seed: Annotated[int, Field(ge=0)] = 1000
+    hold: Positive = 10.0  # [s]
+    band: Positive = 2.0  # [°] noise band about a level
+    tolerance: Positive = 1.0  # [°] acceptable steady-state error
+
+
+class AutoConfig(StrictModel):
+    """Coordinate descent (Algorithm 1): random K and dK, stop on |dK|_1 < k_stop or N sweeps."""
+
+    seed: Annotated[int, Field(ge=0)] = 2000
+    hold: Positive = 4.0  # [s] per level of the reference
+    k_stop: Positive = 0.05
+    max_iterations: Annotated[int, Field(ge=1, le=10_000)] = 30
+    k0_max: GainVector = Field(default_factory=lambda: [2.0, 4.0, 0.2])  # K ~ U(0, k0_max)
+    dk0_max: GainVector = Field(default_factory=lambda: [0.5, 1.0, 0.1])  # dK ~ U(0, dk0_max)
+    upper: GainVector = Field(default_factory=lambda: [20.0, 40.0, 5.0])  # probes beyond fail
+
+
+class TuningConfig(StrictModel):
+    """All tuning runs of the chapter."""
+
+    manual: ManualConfig = ManualConfig()
+    auto: AutoConfig = AutoConfig()
+    plant: PneuNetParams = PneuNetParams()
+
+
+@dataclass(frozen=True)
+class TuningRun:
+    """One coordinate-descent run and the reference levels it tuned on [°]."""
+
+    levels: tuple[float, ...]
+    result: DescentResult
+
+
+def step_reference(levels: tuple[float, ...], hold: float, period: float) -> np.ndarray:
+    """Levels [°] held `hold` seconds each, sampled every PWM period (reference_deg, steps)."""
+    steps = len(levels) * round(hold / period)
+    config = AngleReference(kind="steps", levels_deg=[float(v) for v in levels])
+    return reference_deg(config, np.arange(steps) * period)
+
+
+def manual_run(config: TuningConfig, level: float) -> ManualResult:
+    """The manual procedure on steps from rest to `level` [°]."""
+    m = config.manual
+    reference = step_reference((level,), m.hold, config.plant.pwm_period)
+    rig = SimulatedRig(config.plant, reference, m.seed + int(level) * 100)
+    settings = ManualSettings(band=m.band, tolerance=m.tolerance)
+    return manual_tuning(rig, settings)
+
+
+def auto_run(config: TuningConfig, levels: tuple[float, ...], index: int) -> TuningRun:
+    """Coordinate descent of M (2.5) on steps through `levels` [°]; `index` picks the seed."""
+    a = config.auto
+    reference = step_reference(levels, a.hold, config.plant.pwm_period)
+    rng = np.random.default_rng([a.seed, index])
+    rig = SimulatedRig(config.plant, reference, a.seed * 1000 + index * 100_000)
+
+    def cost(k: np.ndarray) -> float:
+        r = rig(k)
+        return float(tuning_cost(r.t, r.reference, r.measured))  # M(K), Eq. (2.5)
+
+    k0 = rng.uniform(0.0, a.k0_max)  # K ← random 3×1 vector (Algorithm 1)
+    dk0 = rng.uniform(0.0, a.dk0_max) + 1e-6  # dK ← positive random 3×1 vector
+    result = coordinate_descent(
+        cost, k0, dk0, a.k_stop, a.max_iterations, lower=np.zeros(3), upper=np.array(a.upper)
+    )
+    return TuningRun(levels, result)
+
+
+@dataclass(frozen=True, eq=False)
+class KdProbe:
+    """Paired experiments of one gain set with its K_d replaced by each value of `kd`.
+
+    cost: M (2.5) per K_d and experiment, (len(kd), n). swings: swings of the sensor reading
+    beyond the noise band about each level, summed over the levels, (len(kd), n).
+    sustained: whether some level's swings do not die out (StepFeatures.sustained), same
+    shape. Arrays are read-only.
+    """
+
+    kd: tuple[float, ...]
+    cost: np.ndarray
+    swings: np.ndarray
+    sustained: np.ndarray
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "cost", readonly(self.cost))
+        object.__setattr__(self, "swings", readonly(self.swings))
+        sustained = np.array(self.sustained, dtype=bool)
+        sustained.setflags(write=False)
+        object.__setattr__(self, "sustained", sustained)
+
+
+def kd_probe(
+    plant: PneuNetParams, gains: np.ndarray, levels: tuple[float, ...], hold: float,
+    kd_values: tuple[float, ...], seeds: int, band: float,
+) -> KdProbe:  # fmt: skip
+    """M (2.5) and swings of `seeds` step experiments for the gains with K_d set to each value.
+
+    Every K_d sees the same noise seeds, so differences between K_d values are paired; the
+    experiments run as one batch, which gives the numbers of running them one by one. `band`
+    [°] is the noise band of the swing count.
+    """
+    reference = step_reference(levels, hold, plant.pwm_period)
+    per_level = reference.size // len(levels)
+    seeds_used = range(50_000, 50_000 + seeds)
+    cost, swings, sustained = [], [], []
+    for kd in kd_values:
+        schedule = GainSchedule("constant", np.array([[gains[0], gains[1], kd]]))
+        pid = PID(schedule, (0.0, 255.0))
+        trace = run_closed_loop(plant, pid, reference, seeds_used, vary=False)
+        cost.append(tuning_cost(trace.t, trace.reference, trace.measured))
+        count = np.zeros(seeds, dtype=int)
+        lasting = np.zeros(seeds, dtype=bool)
+        for j in range(len(levels)):
+            part = slice(j * per_level, (j + 1) * per_level)
+            for i in range(seeds):
+                r = Response(trace.t[part], trace.reference[part], trace.measured[i, part])
+                f = step_features(r, band)
+                count[i] += f.peak_sizes.size
+                lasting[i] |= f.sustained()
+        swings.append(count)
+        sustained.append(lasting)
+    return KdProbe(tuple(kd_values), np.array(cost), np.array(swings), np.array(sustained))

@@ -1,0 +1,80 @@
+"""`articula reproduce` and `articula motor analyze`: the book's studies and its motor numbers."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from articula.cli.app import (
+    CORES,
+    Dask,
+    JsonFlag,
+    OutDir,
+    Workers,
+    app,
+    emit_json,
+    motor_app,
+    out,
+    progress_bar,
+)
+
+
+@app.command()
+def reproduce(
+    chapter: Annotated[str, typer.Argument(help="ch1, ch2, ch3, ch4 or all.")] = "all",
+    out_dir: OutDir = Path("report"),
+    full: Annotated[bool, typer.Option("--full", help="Full-size runs instead of quick.")] = False,
+    workers: Workers = CORES,
+    dask: Dask = None,
+    as_json: JsonFlag = False,
+) -> None:
+    """Reproduce the book's figures and tables into OUT/report.md and PNG figures."""
+    from articula.book.reproduce import check_chapter
+    from articula.book.reproduce import reproduce as run_reproduce
+    from articula.runs.records import make_folder
+    from articula.runs.runner import check_backend
+
+    check_chapter(chapter)
+    check_backend(dask)
+    make_folder(out_dir)
+    with progress_bar(as_json) as bar:
+        task = bar.add_task("reproduce", total=None)
+
+        def step(done: int, total: int) -> None:
+            bar.update(task, completed=done, total=total)
+
+        summary = run_reproduce(chapter, out_dir, full, workers, dask, progress=step)
+    if as_json:
+        emit_json(summary)
+    else:
+        out.print(f"report written to {summary['report']}")
+
+
+@motor_app.command("analyze")
+def motor_analyze(
+    preset: Annotated[str | None, typer.Option(help="table4.1 or table4.2.")] = None,
+    params: Annotated[Path | None, typer.Option(help="TOML with R, K, b, J, L (SI).")] = None,
+    voltage: Annotated[float, typer.Option(help="Supply voltage V [V].")] = 12.0,
+    torque: Annotated[float, typer.Option(help="External torque τ_ex [N·m].")] = 0.0,
+    current: Annotated[float, typer.Option(help="Current for ω_c [A].")] = 1.0,
+    as_json: JsonFlag = False,
+) -> None:
+    """State space (4.6), G(s) (4.7), steady state (4.8) and critical speed ω_c of a motor."""
+    from articula.book.ch4.motor_analysis import analyze, load_params
+
+    result = analyze(load_params(preset, params), voltage, torque, current)
+    if as_json:
+        emit_json(result)
+        return
+    ss = result["steady_state"]
+    out.print(f"A = {result['A']}\nB = {result['B']}\npoles = {result['poles']}")
+    for k, tf in result["transfer"].items():
+        out.print(f"{k:>13}: num {tf['num']}  den {tf['den']}")
+    out.print(f"steady state at V={voltage} V, τ_ex={torque} N·m: "
+              f"ω = {ss['omega']:.6g} rad/s, i = {ss['i']:.6g} A")  # fmt: skip
+    if result["omega_c"] is None:
+        out.print(f"ω_c: none ({result['omega_c_note']})")
+    else:
+        out.print(f"ω_c at V={voltage} V, i={current} A: {result['omega_c']:.6g} rad/s")

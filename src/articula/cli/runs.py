@@ -1,0 +1,72 @@
+"""`articula run` and `articula sweep`: any registered experiment, one config or a sweep."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from articula.cli.app import (
+    CORES,
+    Dask,
+    JsonFlag,
+    OutDir,
+    Workers,
+    app,
+    emit_json,
+    out,
+    print_table,
+    progress_bar,
+)
+
+
+@app.command()
+def run(
+    config: Annotated[Path, typer.Argument(help="Experiment config (TOML).")],
+    out_dir: OutDir,
+    as_json: JsonFlag = False,
+) -> None:
+    """Run one experiment config and write config.toml, record.json and trace.parquet."""
+    from articula.runs.registry import with_absolute_paths
+    from articula.runs.runner import run_to_folder
+    from articula.validation import load_toml
+
+    data = with_absolute_paths(load_toml(config), config.parent)
+    record = run_to_folder(data, out_dir, where=str(config))
+    if as_json:
+        emit_json(record)
+        return
+    rows = [(k, "—" if v is None else f"{v:.6g}") for k, v in record["metrics"].items()]
+    print_table(f"{record['experiment']} (seed {record['seed']})", ("metric", "value"), rows)
+    out.print(f"written to {out_dir}")
+
+
+@app.command()
+def sweep(
+    spec: Annotated[Path, typer.Argument(help="Sweep file (TOML with base, grid, runs).")],
+    out_dir: OutDir,
+    workers: Workers = CORES,
+    dask: Dask = None,
+    as_json: JsonFlag = False,
+) -> None:
+    """Run every config of a sweep, skipping finished runs; writes results.parquet."""
+    from articula.runs.records import make_folder
+    from articula.runs.runner import RESULTS, check_backend, run_sweep
+    from articula.runs.sweep import expand_sweep
+    from articula.validation import load_toml
+
+    configs = expand_sweep(load_toml(spec), spec.parent)
+    check_backend(dask)
+    make_folder(out_dir)
+    with progress_bar(as_json) as bar:
+        task = bar.add_task("sweep", total=len(configs))
+        table = run_sweep(
+            configs, out_dir, workers=workers, dask=dask,
+            progress=lambda done, total: bar.update(task, completed=done),
+        )  # fmt: skip
+    summary = {"runs": table.num_rows, "results": str(out_dir / RESULTS)}
+    if as_json:
+        emit_json(summary)
+    else:
+        out.print(f"{summary['runs']} runs; results in {summary['results']}")

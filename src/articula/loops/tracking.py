@@ -1,0 +1,107 @@
+"""The arm's closed loop: a planner tracks a reference path over time; its metrics and trace."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from articula.errors import ConfigError, InfeasibleError
+from articula.planning.planner import Planner
+from articula.robots.model import RobotModel
+
+Trajectory = Callable[[float], np.ndarray]
+
+
+@dataclass(frozen=True)
+class PlanResult:
+    """Time series of a tracking run: t [s], q [rad], x and x_ref [m], error and clearance [m]."""
+
+    t: np.ndarray
+    q: np.ndarray
+    x: np.ndarray
+    x_ref: np.ndarray
+    error: np.ndarray
+    clearance: np.ndarray
+    planner_seconds: float  # time spent in planner.step alone [s], not in the recording
+
+
+def track(
+    planner: Planner, trajectory: Trajectory, q0: np.ndarray, dt: float, duration: float
+) -> PlanResult:
+    """Follow `trajectory` from q0 [rad] for `duration` [s], one planner step per `dt` [s]."""
+    if not (np.isfinite(dt) and dt > 0):
+        raise ConfigError("dt", f"must be finite and > 0 s (got {dt})")
+    if not (np.isfinite(duration) and duration >= dt):
+        raise ConfigError("duration", f"must be finite and at least dt = {dt} s (got {duration})")
+    scene, robot = planner.scene, planner.scene.robot
+    q = robot.check_q(q0, "q0").copy()
+    if np.any(q < robot.lower) or np.any(q > robot.upper):
+        raise InfeasibleError("the start breaks the joint limits (Eq. 1.9)", "q0")
+    if scene.obstacles:
+        d0 = scene.min_distance(q)
+        if d0 <= 0:
+            raise InfeasibleError(f"the start collides with an obstacle (d = {d0:.4f} m)", "q0")
+        if d0 <= planner.d_min:
+            raise InfeasibleError(
+                f"the start is {d0:.4f} m from an obstacle, within d_min = {planner.d_min} m "
+                "(Eq. 1.12); lower d_min or move the start",
+                "q0",
+            )
+    steps = round(duration / dt)
+    t = np.arange(steps) * dt
+    qs = np.empty((steps, q.size))
+    x = np.empty((steps, 3))
+    x_ref = np.empty((steps, 3))
+    clearance = np.full(steps, np.inf)
+    planner_seconds = 0.0
+    for n, tn in enumerate(t):
+        x_ref[n] = trajectory(tn)
+        start = time.perf_counter()
+        q = planner.step(q, x_ref[n], tn)
+        planner_seconds += time.perf_counter() - start
+        qs[n] = q
+        x[n] = robot.ee_position(q)
+        if scene.obstacles:
+            clearance[n] = scene.min_distance(q, tn)
+    error = np.linalg.norm(x - x_ref, axis=1)
+    return PlanResult(t, qs, x, x_ref, error, clearance, planner_seconds)
+
+
+def tracking_metrics(
+    run: PlanResult, robot: RobotModel, settle: float, iterations: float
+) -> dict[str, float]:
+    """Metrics of a tracking run.
+
+    rms_error and max_error [m] after `settle` [s]; clearance [m] and colliding steps over the
+    whole run and after `settle` (the approach from q0 is the riskiest part); joint-limit
+    violations; planner time per inner iteration (`iterations` in all) and per period [µs].
+    """
+    settled = run.t >= settle
+    late = run.error[settled]
+    outside = (run.q < robot.lower) | (run.q > robot.upper)
+    return {
+        "settle_s": settle,
+        "rms_error": float(np.sqrt(np.mean(late**2))),
+        "max_error": float(late.max()),
+        "min_clearance": float(run.clearance.min()),
+        "min_clearance_settled": float(run.clearance[settled].min()),
+        "collisions": float(np.sum(run.clearance <= 0.0)),
+        "collisions_settled": float(np.sum(run.clearance[settled] <= 0.0)),
+        "joint_limit_violations": float(np.sum(np.any(outside, axis=1))),
+        # The planner alone: BAORNN's inner iterations, or a baseline's periods.
+        "time_per_iteration_us": 1e6 * run.planner_seconds / max(iterations, 1.0),
+        "time_per_period_us": 1e6 * run.planner_seconds / len(run.t),
+    }
+
+
+def trace_columns(run: PlanResult) -> dict[str, np.ndarray]:
+    """The run as trace columns: t, q_1..q_m, x, y, z, x_ref, y_ref, z_ref, error, clearance."""
+    columns = {"t": run.t}
+    columns.update({f"q_{j + 1}": run.q[:, j] for j in range(run.q.shape[1])})
+    columns.update({"x": run.x[:, 0], "y": run.x[:, 1], "z": run.x[:, 2]})
+    columns.update({"x_ref": run.x_ref[:, 0], "y_ref": run.x_ref[:, 1], "z_ref": run.x_ref[:, 2]})
+    columns.update({"error": run.error, "clearance": run.clearance})
+    return columns

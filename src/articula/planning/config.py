@@ -1,0 +1,128 @@
+"""The [trajectory] and [planner] tables of a scene file, validated, and what they build."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Literal
+
+import numpy as np
+from pydantic import Field, model_validator
+
+from articula.planning.baornn import Baornn, BaornnParams
+from articula.planning.baornn_improved import ImprovedBaornn, ImprovedParams
+from articula.planning.objective import Objective
+from articula.planning.planner import Planner
+from articula.planning.qp_ik import QpIk, QpIkParams
+from articula.planning.trajectories import Circle, Waypoints, rectangle
+from articula.planning.velocity_ik import VelocityIk, VelocityIkParams
+from articula.scene.config import resolve_path
+from articula.scene.scene import Scene
+from articula.validation import Finite, NonNegative, Positive, StrictModel, field_error, fields_as
+
+Vec3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
+Method = Literal["baornn", "baornn-improved", "pinv", "dls", "qp"]
+
+
+class TrajectorySpec(StrictModel):
+    """[trajectory]: circle (Eq. 1.27), rectangle, waypoints or csv."""
+
+    type: Literal["circle", "rectangle", "waypoints", "csv"]
+    center: Vec3 | None = None
+    axis_a: Vec3 | None = None
+    axis_b: Vec3 | None = None
+    radius: Positive | None = None
+    period: Positive | None = None
+    vertices: list[Vec3] | None = None
+    points: list[Vec3] | None = None
+    times: list[Finite] | None = None
+    path: str | None = None
+
+    @model_validator(mode="after")
+    def _fields_of_type(self) -> TrajectorySpec:
+        needed = {
+            "circle": ("center", "axis_a", "axis_b", "radius", "period"),
+            "rectangle": ("vertices", "period"),
+            "waypoints": ("points", "times"),
+            "csv": ("path",),
+        }[self.type]
+        missing = [k for k in needed if getattr(self, k) is None]
+        if missing:
+            raise ValueError(f"type = {self.type!r} needs {', '.join(missing)}")
+        return self
+
+
+class PlannerSpec(StrictModel):
+    """[planner]: the method and its parameters; keys a method does not use are ignored.
+
+    BAORNN (both): lambda_weight Λ, beta β (Eq. 1.11), d_min (1.12), c1, c2 (1.23-1.24),
+    iterations_per_step, seed; baornn-improved also `pairs`. Baselines: gain K [1/s];
+    pinv/dls: repulsion η, influence [m], damping μ [m] (dls); qp: influence, safety [m].
+    `seed` is also accepted at the top of a plan config, where it wins (see PlanConfig).
+    """
+
+    method: Method = "baornn"
+    lambda_weight: NonNegative = 0.0  # Λ of Eq. (1.11)
+    beta: NonNegative = 1.0
+    d_min: NonNegative = 0.0  # [m], Eq. (1.12)
+    dt: Positive = 0.01  # [s] control period
+    iterations_per_step: Annotated[int, Field(ge=1, le=10_000)] = 10
+    duration: Positive = 50.0  # [s]
+    settle: NonNegative | None = None  # [s] before rms_error and max_error; default min(5, T/2)
+    tolerance: Positive = 0.05  # [m] an rms_error above it means the path was not tracked
+    c1: Positive = 0.5
+    c2: Positive = 0.5
+    pairs: Annotated[int, Field(ge=1, le=64)] = 3
+    gain: NonNegative = 20.0
+    damping: NonNegative = 0.02
+    repulsion: NonNegative = 0.02
+    influence: Positive = 0.15
+    safety: NonNegative = 0.03
+    seed: Annotated[int, Field(ge=0)] | None = None
+
+    @model_validator(mode="after")
+    def _times(self) -> PlannerSpec:
+        if self.settle is None:
+            object.__setattr__(self, "settle", min(5.0, self.duration / 2))
+        if self.settle >= self.duration:
+            raise field_error("settle", f"must be shorter than duration = {self.duration} s")
+        if self.safety >= self.influence:
+            raise field_error("safety", f"must be smaller than influence = {self.influence} m")
+        return self
+
+
+def make_planner(spec: PlannerSpec, scene: Scene, seed: int) -> Planner:
+    """The planner a PlannerSpec names, on `scene`, its randomness drawn from `seed`."""
+    rng = np.random.default_rng(seed)
+    objective = Objective(scene, spec.lambda_weight, spec.beta, spec.d_min)
+    if spec.method == "baornn":
+        params = BaornnParams(c1=spec.c1, c2=spec.c2, iterations_per_step=spec.iterations_per_step)
+        return Baornn(objective, params, rng)
+    if spec.method == "baornn-improved":
+        improved = ImprovedParams(c1=spec.c1, c2=spec.c2, pairs=spec.pairs,
+                                  iterations_per_step=spec.iterations_per_step)  # fmt: skip
+        return ImprovedBaornn(objective, improved, rng)
+    if spec.method == "qp":
+        qp = QpIkParams(gain=spec.gain, influence=spec.influence, safety=spec.safety)
+        return QpIk(scene, spec.dt, qp, spec.d_min)
+    velocity = VelocityIkParams(gain=spec.gain, damping=spec.damping, repulsion=spec.repulsion,
+                                influence=spec.influence)  # fmt: skip
+    return VelocityIk(scene, spec.method, spec.dt, velocity, spec.d_min)
+
+
+def make_trajectory(spec: TrajectorySpec, base_dir: Path) -> Circle | Waypoints:
+    """The reference path a TrajectorySpec names; a CSV path is relative to `base_dir`.
+    Errors name the [trajectory] key at fault."""
+    with fields_as({name: f"trajectory.{name}" for name in TrajectorySpec.model_fields}):
+        return _trajectory(spec, base_dir)
+
+
+def _trajectory(spec: TrajectorySpec, base_dir: Path) -> Circle | Waypoints:
+    """make_trajectory without the renaming of its errors."""
+    if spec.type == "circle":
+        return Circle.create(spec.center or [], spec.axis_a or [], spec.axis_b or [],
+                             spec.radius or 0.0, spec.period or 0.0)  # fmt: skip
+    if spec.type == "rectangle":
+        return rectangle(spec.vertices or [], spec.period or 0.0)
+    if spec.type == "waypoints":
+        return Waypoints.create(spec.points or [], spec.times or [])
+    return Waypoints.from_csv(resolve_path(base_dir, spec.path or ""))

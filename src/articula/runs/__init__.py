@@ -1,0 +1,1 @@
+"""Any registered experiment, any backend: the registry, run folders, sweeps and the runner."""

@@ -1,0 +1,143 @@
+"""Run folders: config.toml, record.json, trace.parquet, each written atomically."""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import platform
+import tempfile
+from collections.abc import Mapping
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+import tomli_w
+
+from articula import __version__
+from articula.errors import ConfigError
+from articula.runs.registry import Result
+
+RECORD = "record.json"
+CONFIG = "config.toml"
+TRACE = "trace.parquet"
+_VERSIONED = (
+    "articula", "numpy", "scipy", "numba", "control", "pyarrow", "pydantic",
+    "pin", "coal", "trimesh",
+)  # fmt: skip
+
+
+def config_hash(config: Mapping[str, Any]) -> str:
+    """Short stable hash of a config mapping and the articula version; names its run folder.
+
+    The version is hashed too, so that a sweep resumed after an upgrade recomputes its runs
+    instead of mixing results of two versions of the code.
+    """
+    payload = {"config": dict(config), "articula": __version__}
+    canonical = json.dumps(payload, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(canonical.encode()).hexdigest()[:12]
+
+
+def package_versions() -> dict[str, str]:
+    """Versions of Python and of the packages that decide the numbers."""
+    versions = {"python": platform.python_version()}
+    for name in _VERSIONED:
+        try:
+            versions[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            versions[name] = "not installed"
+    return versions
+
+
+def build_record(config: Mapping[str, Any], result: Result, wall_time: float) -> dict[str, Any]:
+    """The JSON-ready record of one run."""
+    return {
+        "experiment": config["experiment"],
+        "seed": config.get("seed"),
+        "config_hash": config_hash(config),
+        "metrics": {k: _json_number(v) for k, v in result.metrics.items()},
+        "versions": package_versions(),
+        "wall_time_s": wall_time,
+    }
+
+
+def write_run(
+    folder: Path,
+    config: Mapping[str, Any],
+    record: Mapping[str, Any],
+    trace: Mapping[str, np.ndarray],
+) -> None:
+    """Write a complete run folder; record.json goes last and marks the run finished."""
+    make_folder(folder)
+    for stale in folder.glob(".*.tmp"):  # left by a run killed while writing
+        stale.unlink(missing_ok=True)
+    atomic_write(folder / CONFIG, tomli_w.dumps(dict(config)).encode())
+    table = pa.table({k: np.asarray(v) for k, v in trace.items()})
+    sink = pa.BufferOutputStream()
+    pq.write_table(table, sink)
+    atomic_write(folder / TRACE, sink.getvalue().to_pybytes())
+    atomic_write(folder / RECORD, json.dumps(record, indent=2).encode())
+
+
+def make_folder(path: Path) -> None:
+    """Create an output folder, with a clear error when a file is in the way."""
+    if path.exists() and not path.is_dir():
+        raise ConfigError("--out", f"{path} is a file; give a folder path")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError("--out", f"cannot create {path} ({exc.strerror})") from None
+
+
+def is_finished(folder: Path) -> bool:
+    """True when the run folder holds a complete record."""
+    return (folder / RECORD).is_file()
+
+
+def read_record(folder: Path) -> dict[str, Any]:
+    """The record.json of a finished run."""
+    return json.loads((folder / RECORD).read_text())
+
+
+def read_trace(folder: Path) -> dict[str, np.ndarray]:
+    """The trace.parquet of a run folder as columns."""
+    table = pq.read_table(folder / TRACE)
+    return {name: table[name].to_numpy() for name in table.column_names}
+
+
+def write_table(path: Path, table: pa.Table) -> None:
+    """Write a Parquet table atomically."""
+    sink = pa.BufferOutputStream()
+    pq.write_table(table, sink)
+    atomic_write(path, sink.getvalue().to_pybytes())
+
+
+def atomic_write(path: Path, data: bytes) -> None:
+    """Write to a temporary file beside `path`, flush it to disk, then rename over `path`."""
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.chmod(tmp, 0o644)  # mkstemp creates 0600; results are meant to be shared
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    # Make the rename itself durable.
+    dir_fd = os.open(path.parent, os.O_RDONLY)
+    try:
+        os.fsync(dir_fd)
+    finally:
+        os.close(dir_fd)
+
+
+def _json_number(value: float) -> float | None:
+    """A metric as JSON allows it: non-finite values become null."""
+    value = float(value)
+    return value if math.isfinite(value) else None

@@ -1,0 +1,106 @@
+"""Experiments by name, found through the `articula.experiments` entry-point group.
+
+The run layer knows no experiment: each one is an `Experiment` object in the module that owns
+it, named in pyproject.toml (`"motor.current" = "articula.book.ch4.experiment:CURRENT_CONTROL"`).
+Loading an entry point imports only that module, so there is no import cycle, and a package of
+one's own can add experiments without touching articula.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from functools import cache
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pydantic import BaseModel
+
+from articula.errors import ConfigError
+from articula.validation import parse_model
+
+GROUP = "articula.experiments"
+
+
+@dataclass(frozen=True)
+class Result:
+    """What an experiment returns: scalar metrics and equally long time-series columns."""
+
+    metrics: dict[str, float]
+    trace: dict[str, np.ndarray]
+
+
+def _no_paths(data: dict[str, Any], base_dir: Path) -> dict[str, Any]:
+    """The default path hook: a config without file paths is returned as it is."""
+    return data
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """A named experiment: its config model and its run function.
+
+    Attributes:
+        name: the value of a config's `experiment` key.
+        config: the pydantic model of its config (everything but `experiment`).
+        run: config model -> Result.
+        resolve_paths: (raw config, folder of its file) -> the config with every file path it
+            holds made absolute, so that a run folder's config.toml still finds its files.
+    """
+
+    name: str
+    config: type[BaseModel]
+    run: Callable[[Any], Result]
+    resolve_paths: Callable[[dict[str, Any], Path], dict[str, Any]] = _no_paths
+
+
+@cache
+def _entry_points() -> dict[str, metadata.EntryPoint]:
+    """Installed experiments by name."""
+    return {ep.name: ep for ep in metadata.entry_points(group=GROUP)}
+
+
+def names() -> list[str]:
+    """Names of every installed experiment, sorted."""
+    return sorted(_entry_points())
+
+
+def experiment(name: str) -> Experiment:
+    """The installed experiment called `name`."""
+    entry = _entry_points().get(name)
+    if entry is None:
+        known = ", ".join(names()) or "none installed (pip install -e . registers them)"
+        raise ConfigError("experiment", f"unknown experiment {name!r}; choose one of: {known}")
+    found = entry.load()
+    if not isinstance(found, Experiment) or found.name != name:
+        raise ConfigError("experiment", f"entry point {entry.value} is not the Experiment {name!r}")
+    return found
+
+
+def parse_config(data: Mapping[str, Any], where: str = "") -> tuple[Experiment, BaseModel]:
+    """Validate a config mapping (with its `experiment` key) into its experiment's model;
+    errors are prefixed with `where` (a file name) when given."""
+    body = dict(data)
+    if "experiment" not in body:
+        field = f"{where}: experiment" if where else "experiment"
+        raise ConfigError(field, 'required key is missing (e.g. experiment = "motor.current")')
+    exp = experiment(str(body.pop("experiment")))
+    return exp, parse_model(exp.config, body, where)
+
+
+def config_to_dict(exp: Experiment, config: BaseModel) -> dict[str, Any]:
+    """The full config (defaults filled in) as a plain mapping with its `experiment` key."""
+    return {"experiment": exp.name, **config.model_dump(mode="json", exclude_none=True)}
+
+
+def with_absolute_paths(data: Mapping[str, Any], base_dir: Path) -> dict[str, Any]:
+    """A config read from a file in `base_dir`, its file paths made absolute by its experiment.
+
+    A config without a valid `experiment` key is returned unchanged: validation reports it.
+    """
+    body = dict(data)
+    name = body.get("experiment")
+    if not isinstance(name, str) or name not in _entry_points():
+        return body
+    return experiment(name).resolve_paths(body, base_dir)

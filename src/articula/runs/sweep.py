@@ -1,0 +1,73 @@
+"""Sweep files: a [base] config, a [grid] of dotted keys to lists, [[runs]] of partial configs."""
+
+from __future__ import annotations
+
+import copy
+import itertools
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from articula.errors import ConfigError
+from articula.runs import records
+from articula.runs.registry import config_to_dict, parse_config, with_absolute_paths
+
+
+def expand_sweep(spec: Mapping[str, Any], base_dir: Path | None = None) -> list[dict[str, Any]]:
+    """Configs of a sweep: `base` updated by every point of `grid` and every entry of `runs`.
+
+    `grid` maps dotted keys ("controller.filter_order") to lists of values and is expanded as a
+    Cartesian product; `runs` is a list of partial configs. Every config is validated here, so
+    a bad sweep fails before anything runs. File paths in the configs start at `base_dir`
+    (the sweep file's folder) and come out absolute.
+    """
+    unknown = set(spec) - {"base", "grid", "runs"}
+    if unknown:
+        raise ConfigError(sorted(unknown)[0], "unknown sweep key; use base, grid and runs")
+    base = copy.deepcopy(spec.get("base", {}))
+    grid = copy.deepcopy(spec.get("grid", {}))
+    runs = copy.deepcopy(spec.get("runs", [{}]))
+    if not isinstance(base, dict):
+        raise ConfigError("base", "must be a table of config keys ([base])")
+    if not isinstance(grid, dict):
+        raise ConfigError("grid", 'must be a table of dotted keys to lists ([grid] "a.b" = [...])')
+    if not isinstance(runs, list) or not all(isinstance(r, dict) for r in runs):
+        raise ConfigError("runs", "must be a list of tables ([[runs]])")
+    for key, values in grid.items():
+        if not isinstance(values, list) or not values:
+            raise ConfigError(f"grid.{key}", "must be a non-empty list of values")
+    configs = []
+    for point in itertools.product(*grid.values()):
+        for run in runs:
+            cfg = _deep_merge(base, run)
+            for key, value in zip(grid, point, strict=True):
+                _set_dotted(cfg, key, value)
+            if base_dir is not None:
+                cfg = with_absolute_paths(cfg, base_dir)
+            configs.append(config_to_dict(*parse_config(cfg)))
+    hashes = [records.config_hash(c) for c in configs]
+    if len(set(hashes)) != len(hashes):
+        raise ConfigError("grid", "two points of the sweep give the same config; remove the repeat")
+    return configs
+
+
+def _deep_merge(a: Mapping[str, Any], b: Mapping[str, Any]) -> dict[str, Any]:
+    """Nested copy of `a` with `b` laid over it."""
+    merged = {k: (dict(v) if isinstance(v, Mapping) else v) for k, v in a.items()}
+    for k, v in b.items():
+        if isinstance(v, Mapping) and isinstance(merged.get(k), Mapping):
+            merged[k] = _deep_merge(merged[k], v)
+        else:
+            merged[k] = v
+    return merged
+
+
+def _set_dotted(cfg: dict[str, Any], key: str, value: Any) -> None:
+    """Set cfg["a"]["b"] for key "a.b", creating tables as needed."""
+    *parents, leaf = key.split(".")
+    node = cfg
+    for part in parents:
+        node = node.setdefault(part, {})
+        if not isinstance(node, dict):
+            raise ConfigError(f"grid.{key}", f"{part!r} is not a table in the base config")
+    node[leaf] = value

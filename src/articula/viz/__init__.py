@@ -1,1 +1,0 @@
-"""Matplotlib figures per chapter; imported only where plots are made."""

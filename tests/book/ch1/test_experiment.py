@@ -1,0 +1,168 @@
+"""The `baornn.plan` experiment: a plan config validated, run, refused, re-run from a folder."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from articula.book.ch1 import experiment
+from articula.book.ch1.experiment import PlanConfig, absolute_paths, load_plan, run_plan
+from articula.errors import ConfigError, InfeasibleError
+from articula.planning.config import PlannerSpec
+from articula.runs.registry import parse_config
+from articula.runs.runner import execute
+from articula.validation import parse_model
+
+CONFIGS = Path(__file__).resolve().parents[3] / "src/articula/book/ch1/configs"
+BALL_SCENE: dict[str, Any] = {
+    "robot": {"builtin": "iiwa14", "q0": [0.0] * 7},
+    "obstacles": [{"name": "ball", "sphere": 0.08, "position": [0.35, 0.35, 0.6]}],
+    "trajectory": {
+        "type": "circle",
+        "center": [0.0, 0.6, 0.5],
+        "axis_a": [1.0, 0.0, 0.0],
+        "axis_b": [0.0, 0.0, 1.0],
+        "radius": 0.2,
+        "period": 50.0,
+    },
+    "planner": {"method": "qp", "duration": 2.0, "settle": 1.0},
+}
+
+
+def _data(trajectory: dict | None = None, **planner: Any) -> dict[str, Any]:
+    data = copy.deepcopy(BALL_SCENE)
+    data["trajectory"].update(trajectory or {})
+    data["planner"].update(planner)
+    return data
+
+
+def _config(data: dict[str, Any]) -> PlanConfig:
+    return parse_model(PlanConfig, data, "scene.toml")
+
+
+def _no_planning(monkeypatch) -> None:
+    def refuse(*args, **kwargs):
+        raise AssertionError("planning started")
+
+    monkeypatch.setattr(experiment, "make_planner", refuse)
+    monkeypatch.setattr(experiment, "track", refuse)
+
+
+def test_a_path_out_of_reach_is_refused_before_any_planning(monkeypatch):
+    _no_planning(monkeypatch)
+    with pytest.raises(InfeasibleError) as err:
+        run_plan(_config(_data({"center": [2.0, 0.0, 0.5]})))
+    message = str(err.value)
+    assert err.value.field == "trajectory" and "reach" in message
+    assert "\n" not in message
+
+
+def test_a_path_just_within_reach_is_not_refused_by_the_reach_check(monkeypatch):
+    # The check must not refuse what the arm can reach: the book circle passes it.
+    _no_planning(monkeypatch)
+    with pytest.raises(AssertionError, match="planning started"):
+        run_plan(_config(_data()))
+
+
+def test_an_untracked_path_is_refused_naming_the_tolerance():
+    with pytest.raises(InfeasibleError) as err:
+        run_plan(_config(_data(tolerance=1e-9)))
+    assert "tolerance" in str(err.value) and err.value.field == "trajectory"
+
+
+def test_a_start_inside_d_min_is_refused_naming_robot_q0():
+    with pytest.raises(InfeasibleError) as err:
+        run_plan(_config(_data(d_min=0.5)))
+    assert err.value.field == "robot.q0" and "d_min" in str(err.value)
+
+
+@pytest.mark.parametrize(
+    ("planner", "words"),
+    [
+        ({"method": "magic"}, ("planner", "method", "magic")),
+        ({"settle": 2.0}, ("planner", "settle", "duration")),
+        ({"settle": 3.0}, ("planner", "settle", "duration")),
+        ({"safety": 0.15}, ("planner", "safety", "influence")),
+        ({"safety": 0.2, "influence": 0.1}, ("planner", "safety", "influence")),
+    ],
+    ids=["unknown_method", "settle_equals_duration", "settle_after_end", "safety_equals_influence",
+         "safety_beyond_influence"],
+)  # fmt: skip
+def test_bad_planner_tables_are_config_errors_naming_the_file(planner, words):
+    with pytest.raises(ConfigError) as err:
+        _config(_data(**planner))
+    for word in ("scene.toml", *words):
+        assert word in str(err.value), (word, str(err.value))
+    with pytest.raises(ConfigError):
+        PlannerSpec(**{"duration": 2.0, **planner})
+
+
+@pytest.mark.parametrize(
+    ("planner", "field"),
+    [
+        ({"method": "magic"}, "planner.method"),
+        ({"settle": 2.0}, "planner.settle"),
+        ({"safety": 0.15}, "planner.safety"),
+    ],
+    ids=["method", "settle", "safety"],
+)
+def test_bad_planner_fields_are_named_with_their_dotted_path(planner, field):
+    with pytest.raises(ConfigError) as err:
+        _config(_data(**planner))
+    assert field in err.value.field
+
+
+def test_the_seed_is_held_once_at_the_top():
+    assert _config(_data()).seed == 0
+    from_planner = _config(_data(seed=4))
+    assert from_planner.seed == 4 and from_planner.planner.seed is None
+    top = _config({**_data(seed=4), "seed": 7})
+    assert top.seed == 7  # the top-level seed wins (a sweep over `seed`)
+    assert "seed" not in top.model_dump(exclude_none=True)["planner"]
+
+
+def test_absolute_paths_makes_every_file_path_absolute_and_leaves_the_input(tmp_path):
+    data = {
+        "robot": {"urdf": "arm.urdf", "package_dirs": ["pkgs"]},
+        "obstacles": [{"mesh": "rock.stl"}, {"sphere": 0.1}],
+        "trajectory": {"type": "csv", "path": "path.csv"},
+    }
+    original = copy.deepcopy(data)
+    out = absolute_paths(data, tmp_path)
+    assert out["robot"]["urdf"] == str((tmp_path / "arm.urdf").resolve())
+    assert out["robot"]["package_dirs"] == [str((tmp_path / "pkgs").resolve())]
+    assert out["obstacles"][0]["mesh"] == str((tmp_path / "rock.stl").resolve())
+    assert out["obstacles"][1] == {"sphere": 0.1}
+    assert out["trajectory"]["path"] == str((tmp_path / "path.csv").resolve())
+    assert data == original
+
+
+def test_the_run_config_keeps_mesh_paths_that_still_resolve(tmp_path):
+    scene_dir = tmp_path / "scenes"
+    scene_dir.mkdir()
+    (scene_dir / "rock.stl").write_bytes((CONFIGS / "rock.stl").read_bytes())
+    (scene_dir / "scene.toml").write_text(
+        '[robot]\nbuiltin = "iiwa14"\n[[obstacles]]\nname = "rock"\nmesh = "rock.stl"\n'
+        'position = [0.0, 0.3, 0.9]\n[trajectory]\ntype = "circle"\ncenter = [0.0, 0.6, 0.5]\n'
+        "axis_a = [1.0, 0.0, 0.0]\naxis_b = [0.0, 0.0, 1.0]\nradius = 0.2\nperiod = 50.0\n"
+        "[planner]\nduration = 0.2\nsettle = 0.1\ntolerance = 10.0\n"
+    )
+    output = execute(load_plan(scene_dir / "scene.toml"))
+    mesh = Path(output.config["obstacles"][0]["mesh"])
+    assert mesh.is_absolute() and mesh.exists()
+    assert output.record["experiment"] == "baornn.plan"
+
+
+def test_load_plan_refuses_another_experiment(tmp_path):
+    path = tmp_path / "motor.toml"
+    path.write_text('experiment = "motor.current"\n')
+    with pytest.raises(ConfigError, match="articula run"):
+        load_plan(path)
+
+
+def test_a_plan_config_is_registered_under_its_name():
+    exp, model = parse_config({**_data(), "experiment": "baornn.plan"})
+    assert exp is experiment.PLAN and isinstance(model, PlanConfig)

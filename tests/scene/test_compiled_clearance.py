@@ -1,0 +1,63 @@
+"""scene/compiled_clearance.py: the compiled clearance and end-effector position against Pinocchio
++ coal, on meshes and primitives; warm starts; the scenes it leaves to coal."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from articula.geometry.poses import pose
+from articula.geometry.shapes import box, capsule, cylinder, sphere
+from articula.robots import RobotModel
+from articula.scene import Obstacle, Scene
+from articula.scene.compiled_clearance import CompiledClearance
+from tests.scene.helpers import book_scene
+
+ROBOT = RobotModel.builtin("iiwa14")
+
+
+def test_mesh_scene_agrees_with_coal_including_overlaps():
+    scene = book_scene("circle_two_obstacles")
+    compiled = CompiledClearance.build(scene)
+    assert compiled is not None
+    rng = np.random.default_rng(7)
+    overlaps = 0
+    for q in rng.uniform(ROBOT.lower, ROBOT.upper, (400, ROBOT.nq)):
+        d, ee = compiled.evaluate(q)
+        reference = scene.min_distance(q)
+        overlaps += reference <= 0
+        # coal's GJK stops at its own tolerance; overlaps are clearance 0 here.
+        assert d == pytest.approx(max(reference, 0.0), abs=1e-6)
+        assert np.allclose(ee, ROBOT.ee_position(q), atol=1e-12)
+    assert overlaps > 0  # the sample did test the overlapping case
+
+
+@pytest.mark.parametrize(
+    "part",
+    [sphere(0.07), capsule(0.05, 0.3), box((0.1, 0.2, 0.15))],
+    ids=["sphere", "capsule", "box"],
+)
+def test_primitive_obstacles_agree_with_coal(part):
+    obstacle = Obstacle("o", (part,), pose([0.3, 0.3, 0.6], [0.3, -0.2, 0.5]))
+    scene = Scene(ROBOT, [obstacle])
+    compiled = CompiledClearance.build(scene)
+    rng = np.random.default_rng(1)
+    for q in rng.uniform(ROBOT.lower, ROBOT.upper, (150, ROBOT.nq)):
+        assert compiled.evaluate(q)[0] == pytest.approx(max(scene.min_distance(q), 0.0), abs=1e-6)
+
+
+def test_warm_start_does_not_change_the_answer():
+    scene = book_scene("circle_two_obstacles")
+    rng = np.random.default_rng(3)
+    Q = rng.uniform(ROBOT.lower, ROBOT.upper, (100, ROBOT.nq))
+    warm = CompiledClearance.build(scene)
+    first = [warm.evaluate(q)[0] for q in Q]
+    again = [warm.evaluate(q)[0] for q in Q[::-1]][::-1]  # other hints and guesses
+    assert np.allclose(first, again, atol=1e-9, rtol=0)
+
+
+def test_moving_obstacles_and_cylinders_have_no_compiled_form():
+    moving = Obstacle("m", (sphere(0.05),), lambda t: pose([0.3, 0.3, 0.5 + 0.01 * t]))
+    assert CompiledClearance.build(Scene(ROBOT, [moving])) is None
+    round_rim = Obstacle("c", (cylinder(0.05, 0.2),), pose([0.3, 0.3, 0.5]))
+    assert CompiledClearance.build(Scene(ROBOT, [round_rim])) is None

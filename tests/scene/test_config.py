@@ -1,0 +1,95 @@
+"""scene/config.py: a scene file's robot and obstacles, moving ones included (a `velocity` moves
+an obstacle at constant speed), give the distances written out by hand."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from articula.scene.config import build_scene, load_scene_spec
+from articula.validation import load_toml
+from tests.scene.helpers import box_signed_distance
+
+BALL_URDF = """<?xml version="1.0"?>
+<robot name="ball">
+  <link name="base"/>
+  <joint name="slide" type="prismatic">
+    <parent link="base"/><child link="ball"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/>
+  </joint>
+  <link name="ball">
+    <collision><origin xyz="0.1 0 0"/><geometry><sphere radius="0.05"/></geometry></collision>
+  </link>
+  <joint name="tool_joint" type="fixed">
+    <parent link="ball"/><child link="tool"/>
+    <origin xyz="0 0.2 0" rpy="0 0 1.5707963267948966"/>
+  </joint>
+  <link name="tool">
+    <collision><origin xyz="0.1 0 0"/><geometry><sphere radius="0.02"/></geometry></collision>
+  </link>
+</robot>
+"""
+
+
+def test_moving_sphere_from_toml(tmp_path, write_toml):
+    (tmp_path / "ball.urdf").write_text(BALL_URDF)
+    path = write_toml(
+        {
+            "robot": {"urdf": "ball.urdf", "q0": [0.05]},
+            "obstacles": [
+                {
+                    "name": "comet",
+                    "sphere": 0.1,
+                    "position": [1.0, 0.0, 0.0],
+                    "velocity": [-0.2, 0.0, 0.0],
+                },
+                {"name": "rock", "sphere": 0.1, "position": [1.0, 0.0, 0.0]},
+                {
+                    "name": "crate",
+                    "box": [0.2, 0.3, 0.2],
+                    "position": [0.1, -1.0, 0.1],
+                    "rpy": [0.0, 0.0, 0.5],
+                    "velocity": [0.0, 0.25, 0.0],
+                },
+            ],
+        },
+        "scene.toml",
+    )
+    scene, q0 = build_scene(load_scene_spec(load_toml(path)), tmp_path)
+    np.testing.assert_array_equal(q0, [0.05])
+    assert scene.link_names == ["ball", "tool"]
+    assert [o.moving for o in scene.obstacles] == [True, False, True]
+    for q in (0.0, 0.05, -0.3):
+        for t in (0.0, 1.0, 2.5, 4.5, 5.0, 7.0):
+            x = 1.0 - 0.2 * t  # the comet's centre moves along x
+            expected_ball = math.dist((x, 0.0, 0.0), (0.1, 0.0, q)) - 0.15
+            # The tool sphere sits at (0, 0.2, q) + Rz(π/2)·(0.1, 0, 0) = (0, 0.3, q).
+            expected_tool = math.dist((x, 0.0, 0.0), (0.0, 0.3, q)) - 0.12
+            d = scene.distances([q], t)
+            assert d[0, 0] == pytest.approx(expected_ball, abs=1e-9), (q, t)
+            assert d[1, 0] == pytest.approx(expected_tool, abs=1e-9), (q, t)
+            # The static twin stays where the comet started.
+            assert d[0, 1] == pytest.approx(math.dist((1, 0, 0), (0.1, 0, q)) - 0.15, abs=1e-9)
+            # The crate slides along y keeping its yaw: the ball in the crate's frame.
+            ball = np.array([0.1, 0.0, q]) - [0.1, -1.0 + 0.25 * t, 0.1]
+            c, s = math.cos(0.5), math.sin(0.5)
+            local = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]]) @ ball
+            expected_crate = box_signed_distance(local, np.array([0.1, 0.15, 0.1])) - 0.05
+            assert d[0, 2] == pytest.approx(expected_crate, abs=1e-7), (q, t)
+            w = scene.witnesses([q], t)
+            np.testing.assert_allclose(w.distance, d, atol=1e-12)
+            if expected_ball > 0:
+                # The comet's witness is on its surface, towards the ball.
+                towards = np.array([0.1 - x, 0.0, q])
+                np.testing.assert_allclose(
+                    w.on_obstacle[0, 0],
+                    [x, 0, 0] + 0.1 * towards / np.linalg.norm(towards),
+                    atol=1e-7,
+                )
+    # Distance falls while the comet approaches, then rises after it passes.
+    series = [scene.distances([0.0], t)[0, 0] for t in np.linspace(0.0, 9.0, 19)]
+    lowest = int(np.argmin(series))
+    assert 0 < lowest < len(series) - 1
+    assert np.all(np.diff(series[: lowest + 1]) < 0) and np.all(np.diff(series[lowest:]) > 0)

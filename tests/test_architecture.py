@@ -1,0 +1,114 @@
+"""The layers of docs/architecture.md hold: imports point down, no cycle, small modules."""
+
+from __future__ import annotations
+
+import ast
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+SRC = Path(__file__).resolve().parents[1] / "src"
+PACKAGE = SRC / "articula"
+# Layer of each top-level package or module; a module imports only lower layers and its own
+# package. The base modules order themselves below.
+LAYERS = {
+    "errors": 0,
+    "numba_cache": 1,
+    "validation": 1,
+    "__init__": 1,
+    "geometry": 2,
+    "plants": 2,
+    "tuning": 2,
+    "robots": 3,
+    "control": 3,
+    "scene": 4,
+    "planning": 5,
+    "loops": 6,
+    "runs": 7,
+    "book": 8,
+    "cli": 9,
+    "__main__": 10,
+}
+MAX_LINES = 400
+
+
+def _modules() -> Iterator[tuple[str, Path]]:
+    for path in sorted(PACKAGE.rglob("*.py")):
+        parts = path.relative_to(SRC).with_suffix("").parts
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        yield ".".join(parts), path
+
+
+def _imports(path: Path, top_level_only: bool) -> set[str]:
+    """articula modules that `path` imports (all of them, or only at module level)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    nodes = tree.body if top_level_only else list(ast.walk(tree))
+    found = set()
+    for node in nodes:
+        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names = [node.module] + [f"{node.module}.{a.name}" for a in node.names]
+        elif isinstance(node, ast.Import):
+            names = [a.name for a in node.names]
+        else:
+            continue
+        found |= {n for n in names if n == "articula" or n.startswith("articula.")}
+    return found
+
+
+def _layer(module: str) -> tuple[str, int]:
+    parts = module.split(".")
+    top = parts[1] if len(parts) > 1 else "__init__"
+    return top, LAYERS[top]
+
+
+MODULES = dict(_modules())
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_a_module_imports_only_lower_layers_and_its_own_package(module):
+    top, layer = _layer(module)
+    for target in _imports(MODULES[module], top_level_only=False):
+        if target not in MODULES:
+            continue  # a name inside a module (from x import name), checked through x
+        other, other_layer = _layer(target)
+        assert other == top or other_layer < layer, f"{module} imports {target}"
+
+
+def test_only_the_cli_and_the_book_itself_import_the_chapter_homes():
+    for module, path in MODULES.items():
+        if module.startswith(("articula.book", "articula.cli")):
+            continue
+        book = {t for t in _imports(path, top_level_only=False) if t.startswith("articula.book")}
+        assert not book, f"{module} imports {sorted(book)}"
+
+
+def test_there_is_no_import_cycle_among_modules():
+    graph = {m: {t for t in _imports(p, top_level_only=True) if t in MODULES and t != m}
+             for m, p in MODULES.items()}  # fmt: skip
+    done: set[str] = set()
+
+    def visit(node: str, path: list[str]) -> None:
+        if node in path:
+            cycle = [*path[path.index(node) :], node]
+            raise AssertionError("import cycle: " + " -> ".join(cycle))
+        if node in done:
+            return
+        for target in graph[node]:
+            visit(target, [*path, node])
+        done.add(node)
+
+    for module in graph:
+        visit(module, [])
+
+
+def test_every_top_level_package_has_a_layer():
+    tops = {_layer(m)[0] for m in MODULES}
+    assert tops <= set(LAYERS)
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_no_source_module_is_over_the_line_limit(module):
+    lines = MODULES[module].read_text(encoding="utf-8").count("\n")
+    assert lines <= MAX_LINES, f"{module}: {lines} lines"
