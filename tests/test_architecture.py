@@ -14,6 +14,8 @@ PACKAGE = SRC / "articula"
 # package. The base modules order themselves below.
 LAYERS = {
     "errors": 0,
+    "limits": 0,
+    "native": 0,
     "numba_cache": 1,
     "validation": 1,
     "__init__": 1,

@@ -37,5 +37,10 @@ class InfeasibleError(ArticulaError, RuntimeError):
         super().__init__(f"{field}: {problem}" if field else problem)
 
 
+class ResourceError(ArticulaError, OSError):
+    """The machine, not the input, stops the work: a folder in use by another process, a full
+    disk, an I/O error, too little memory. The command line exits with status 1 for it."""
+
+
 class DeviceError(ArticulaError, OSError):
     """A bench rig or serial device failed or answered out of protocol."""

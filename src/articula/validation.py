@@ -11,12 +11,21 @@ from typing import Annotated, Any, TypeVar
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from articula.errors import ConfigError, InfeasibleError
+from articula.limits import MAX_ANGLE, MAX_LENGTH
 
 M = TypeVar("M", bound=BaseModel)
-# Field types shared by parameter models: finite floats, optionally bounded.
-Finite = Annotated[float, Field(allow_inf_nan=False)]
-NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
-Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+# Field types shared by parameter models: finite floats within ±MAX_MAGNITUDE, which holds any
+# physical value of this project in SI units and keeps 1e308 from reaching native code.
+MAX_MAGNITUDE = 1e12
+Finite = Annotated[float, Field(ge=-MAX_MAGNITUDE, le=MAX_MAGNITUDE, allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0, le=MAX_MAGNITUDE, allow_inf_nan=False)]
+Positive = Annotated[float, Field(gt=0, le=MAX_MAGNITUDE, allow_inf_nan=False)]
+Seed = Annotated[int, Field(ge=0, lt=2**63)]  # what numpy's generators and numba's ints take
+# Geometry within the stated limits (limits.py): coordinates and sizes [m], angles [rad].
+Length = Annotated[float, Field(ge=-MAX_LENGTH, le=MAX_LENGTH, allow_inf_nan=False)]
+PositiveLength = Annotated[float, Field(gt=0, le=MAX_LENGTH, allow_inf_nan=False)]
+Radians = Annotated[float, Field(ge=-MAX_ANGLE, le=MAX_ANGLE, allow_inf_nan=False)]
+Point = Annotated[list[Length], Field(min_length=3, max_length=3)]
 
 
 class StrictModel(BaseModel):

@@ -167,7 +167,7 @@ def test_check_q_accepts_lists_and_ints(iiwa):
 def test_unknown_builtin_robot():
     with pytest.raises(ConfigError) as exc:
         RobotModel.builtin("ur5")
-    assert exc.value.field == "robot.builtin"
+    assert exc.value.field == "builtin"
     assert "iiwa14" in str(exc.value)
 
 

@@ -10,7 +10,8 @@ from typing import Any
 from articula.book.claims import claims_data, claims_markdown
 from articula.book.study import Progress, Study, no_progress
 from articula.errors import ConfigError
-from articula.runs.records import atomic_write, make_folder, package_versions
+from articula.runs.folders import claimed
+from articula.runs.records import atomic_write, package_versions
 
 # Chapter -> title of its report section; each is the package articula.book.<chapter>, whose
 # `reproduce(study) -> Section` runs it.
@@ -36,12 +37,24 @@ def reproduce(
     workers: int = 1,
     dask: str | None = None,
     progress: Progress | None = None,
+    force: bool = False,
 ) -> dict[str, Any]:
     """Reproduce one chapter or all of them into `out`; returns a summary with the report's
-    path and, under chapters.<ch>, each chapter's numbers, claims and claims_detail."""
+    path and, under chapters.<ch>, each chapter's numbers, claims and claims_detail.
+
+    `out` must be new, empty or a report folder of articula's (`force` accepts any); it is
+    held while the chapters run.
+    """
     check_chapter(chapter)
+    with claimed(out, "report", force):
+        return _reproduce(chapter, out, full, workers, dask, progress or no_progress)
+
+
+def _reproduce(
+    chapter: str, out: Path, full: bool, workers: int, dask: str | None, progress: Progress
+) -> dict[str, Any]:
+    """reproduce() inside the folder it holds."""
     chosen = list(CHAPTERS) if chapter == "all" else [chapter]
-    make_folder(out)
     start = time.perf_counter()
     parts = [
         "# articula: reproduction of the book's experiments",
@@ -55,7 +68,7 @@ def reproduce(
     ]
     chapters: dict[str, dict[str, Any]] = {}
     for name in chosen:
-        study = Study(out / name, full, workers, dask, progress or no_progress)
+        study = Study(out / name, full, workers, dask, progress)
         section = importlib.import_module(f"articula.book.{name}").reproduce(study)
         chapters[name] = {**section.data, **claims_data(section.claims)}
         parts += [f"## {CHAPTERS[name]}", "", section.markdown, ""]

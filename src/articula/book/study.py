@@ -52,10 +52,14 @@ class Study:
         self, configs: Sequence[Mapping[str, Any]], name: str, done: int = 0, total: int = 0
     ) -> pa.Table:
         """Run `configs` into OUT/name (resuming finished runs); progress counts from `done`
-        of `total` (default: the sweep's own size). Returns results.parquet as a table."""
+        of `total` (default: the sweep's own size). Returns results.parquet as a table.
+
+        The report folder holding OUT was checked by reproduce, so the sweep folder is taken
+        as it is (`force`): a report written by an older version is resumed, not refused.
+        """
         total = total or done + len(configs)
         return runner.run_sweep(
-            configs, self.out / name, workers=self.workers, dask=self.dask,
+            configs, self.out / name, workers=self.workers, dask=self.dask, force=True,
             progress=lambda d, _n: self.progress(done + d, total),
         )  # fmt: skip
 

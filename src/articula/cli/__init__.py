@@ -1,31 +1,78 @@
-"""`articula` command line: parses, calls the library, prints. Errors are one line, exit 2."""
+"""`articula` command line: parses, calls the library, prints. Errors are one line.
+
+Exit status: 0 done; 2 bad input (the line names the field or option and the fix); 1 the
+machine stopped the work (disk full, folder in use, I/O error, out of memory); 3 a bug of
+articula's (the line says so; ARTICULA_DEBUG=1 shows the traceback); 130 interrupted.
+"""
 
 from __future__ import annotations
 
+import errno
+import os
 import sys
+import warnings
+from typing import NoReturn
 
 from typer.exceptions import Abort, Exit, TyperException
 
 from articula.cli import arm, book, runs  # noqa: F401  (each module adds its commands to app)
 from articula.cli.app import app
-from articula.errors import ArticulaError
+from articula.errors import ArticulaError, DeviceError, ResourceError
+
+BAD_INPUT, ENVIRONMENT, BUG, INTERRUPTED = 2, 1, 3, 130
+# OS errors that the machine causes; every other OSError is about a path the user gave.
+MACHINE_ERRNOS = {errno.ENOSPC, errno.EDQUOT, errno.EIO, errno.EBUSY, errno.ENOMEM,
+                  errno.EMFILE, errno.ENFILE, errno.ETXTBSY}  # fmt: skip
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Entry point: run the app; any bad input becomes one line on stderr and exit status 2."""
-    try:
-        app(args=argv, standalone_mode=False)
-    except ArticulaError as exc:
-        _fail(str(exc))
-    except Exit as exc:
-        sys.exit(exc.exit_code)
-    except Abort:
-        _fail("aborted")
-    except TyperException as exc:
-        message = exc.format_message().replace("\n", " ").strip()
-        _fail(message or "missing command; see --help")
+    """Entry point: run the app; every failure becomes one line on stderr and its exit status."""
+    debug = bool(os.environ.get("ARTICULA_DEBUG"))
+    with warnings.catch_warnings(record=not debug) as caught:
+        try:
+            app(args=argv, standalone_mode=False)
+        except Exit as exc:
+            sys.exit(exc.exit_code)
+        except Exception as exc:  # every failure, ours or not, ends here as one line
+            if debug:
+                raise
+            _fail(*_status_and_message(exc))
+        except KeyboardInterrupt:
+            _fail(INTERRUPTED, "interrupted; finished runs are kept and a re-run resumes")
+    if caught:
+        first = f"{_one_line(str(caught[0].message))} ({caught[0].category.__name__})"
+        sys.stderr.write(f"warning: {len(caught)} warning(s), the first: {first}\n")
 
 
-def _fail(message: str) -> None:
-    sys.stderr.write(f"error: {message}\n")
-    sys.exit(2)
+def _status_and_message(exc: Exception) -> tuple[int, str]:
+    """The exit status and one-line message of a failure."""
+    if isinstance(exc, (ResourceError, DeviceError)):
+        return ENVIRONMENT, str(exc)
+    if isinstance(exc, ArticulaError):
+        return BAD_INPUT, str(exc)
+    if isinstance(exc, Abort):
+        return BAD_INPUT, "aborted"
+    if isinstance(exc, TyperException):
+        return BAD_INPUT, " ".join(exc.format_message().split()) or "missing command; see --help"
+    if isinstance(exc, MemoryError):
+        return ENVIRONMENT, "out of memory; run a smaller config or free memory"
+    if isinstance(exc, OSError):
+        where = f"{exc.filename}: " if exc.filename else ""
+        reason = exc.strerror or str(exc)
+        if exc.errno in MACHINE_ERRNOS:
+            return ENVIRONMENT, f"{where}{reason}"
+        return BAD_INPUT, f"{where}{reason}; check the path and its permissions"
+    if isinstance(exc, (OverflowError, FloatingPointError)):
+        return BAD_INPUT, f"a number is too large to compute with ({exc}); check the inputs"
+    return BUG, (f"internal error ({type(exc).__name__}: {exc}); please report it with the "
+                 "command (ARTICULA_DEBUG=1 shows the traceback)")  # fmt: skip
+
+
+def _one_line(text: str) -> str:
+    """`text` with its line breaks escaped, so that a message stays one line."""
+    return text.replace("\r", "\\r").replace("\n", "\\n")
+
+
+def _fail(status: int, message: str) -> NoReturn:
+    sys.stderr.write(f"error: {_one_line(message)}\n")
+    sys.exit(status)

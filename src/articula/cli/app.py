@@ -29,6 +29,12 @@ CORES = os.cpu_count() or 1  # default number of local worker processes
 Workers = Annotated[
     int, typer.Option(min=1, help="Local worker processes (default: one per core).")
 ]
+Force = Annotated[
+    bool,
+    typer.Option(
+        "--force", help="Write into a folder that holds other files (only ours are replaced)."
+    ),
+]
 Dask = Annotated[
     str | None, typer.Option(help="'local' for a loopback LocalCluster, or tcp://HOST:PORT.")
 ]
@@ -60,7 +66,10 @@ def print_table(title: str, columns: tuple[str, str], rows: list[tuple[str, str]
 
 
 def progress_bar(quiet: bool) -> Progress:
+    """A progress bar on stderr while work runs; none with --json or without a terminal (a
+    log or a pipe would only collect its frames), and it leaves no line behind, so that an
+    error that ends the work stays the only line."""
     return Progress(
         TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
-        TimeElapsedColumn(), console=err, disable=quiet, transient=False,
+        TimeElapsedColumn(), console=err, disable=quiet or not err.is_terminal, transient=True,
     )  # fmt: skip

@@ -7,7 +7,17 @@ from typing import Annotated
 
 import typer
 
-from articula.cli.app import JsonFlag, OutDir, app, emit_json, out, print_table, scene_app
+from articula.cli.app import (
+    Force,
+    JsonFlag,
+    OutDir,
+    app,
+    emit_json,
+    out,
+    print_table,
+    progress_bar,
+    scene_app,
+)
 
 
 @app.command()
@@ -16,21 +26,29 @@ def plan(
         Path, typer.Argument(help="Scene file with trajectory and planner tables (TOML).")
     ],
     out_dir: OutDir,
+    force: Force = False,
     as_json: JsonFlag = False,
 ) -> None:
     """Track the scene's reference path with its planner; writes a run folder (trace + record)."""
     from articula.book.ch1.experiment import load_plan
     from articula.runs.runner import run_to_folder
 
-    record = run_to_folder(load_plan(scene_file), out_dir, where=str(scene_file))
+    with progress_bar(as_json) as bar:
+        task = bar.add_task("plan", total=None)
+        record = run_to_folder(
+            load_plan(scene_file), out_dir, str(scene_file), force,
+            progress=lambda done, total: bar.update(task, completed=done, total=total),
+        )  # fmt: skip
     if as_json:
         emit_json(record)
         return
     m = record["metrics"]
+    clearance = "no obstacles" if m["min_clearance"] is None else (
+        f"min clearance {m['min_clearance']:.4f} m; collisions {int(m['collisions'])}"
+    )  # fmt: skip
     out.print(f"RMS error after {m['settle_s']:g} s: {1e3 * m['rms_error']:.3f} mm, max "
-              f"{1e3 * m['max_error']:.3f} mm; min clearance {m['min_clearance']:.4f} m; "
-              f"collisions {int(m['collisions'])}; {m['time_per_iteration_us']:.1f} µs per "
-              f"iteration; written to {out_dir}")  # fmt: skip
+              f"{1e3 * m['max_error']:.3f} mm; {clearance}; {m['time_per_iteration_us']:.1f} "
+              f"µs per iteration; written to {out_dir}")  # fmt: skip
 
 
 @scene_app.command("check")

@@ -10,6 +10,7 @@ import typer
 from articula.cli.app import (
     CORES,
     Dask,
+    Force,
     JsonFlag,
     OutDir,
     Workers,
@@ -28,24 +29,25 @@ def reproduce(
     full: Annotated[bool, typer.Option("--full", help="Full-size runs instead of quick.")] = False,
     workers: Workers = CORES,
     dask: Dask = None,
+    force: Force = False,
     as_json: JsonFlag = False,
 ) -> None:
     """Reproduce the book's figures and tables into OUT/report.md and PNG figures."""
     from articula.book.reproduce import check_chapter
     from articula.book.reproduce import reproduce as run_reproduce
-    from articula.runs.records import make_folder
-    from articula.runs.runner import check_backend
+    from articula.runs.backends import check_backend
+    from articula.runs.folders import check_out
 
     check_chapter(chapter)
     check_backend(dask)
-    make_folder(out_dir)
+    check_out(out_dir, "report", force)
     with progress_bar(as_json) as bar:
         task = bar.add_task("reproduce", total=None)
 
         def step(done: int, total: int) -> None:
             bar.update(task, completed=done, total=total)
 
-        summary = run_reproduce(chapter, out_dir, full, workers, dask, progress=step)
+        summary = run_reproduce(chapter, out_dir, full, workers, dask, step, force)
     if as_json:
         emit_json(summary)
     else:

@@ -10,6 +10,7 @@ import typer
 from articula.cli.app import (
     CORES,
     Dask,
+    Force,
     JsonFlag,
     OutDir,
     Workers,
@@ -19,12 +20,14 @@ from articula.cli.app import (
     print_table,
     progress_bar,
 )
+from articula.limits import MAX_RUNS
 
 
 @app.command()
 def run(
     config: Annotated[Path, typer.Argument(help="Experiment config (TOML).")],
     out_dir: OutDir,
+    force: Force = False,
     as_json: JsonFlag = False,
 ) -> None:
     """Run one experiment config and write config.toml, record.json and trace.parquet."""
@@ -33,7 +36,7 @@ def run(
     from articula.validation import load_toml
 
     data = with_absolute_paths(load_toml(config), config.parent)
-    record = run_to_folder(data, out_dir, where=str(config))
+    record = run_to_folder(data, out_dir, where=str(config), force=force)
     if as_json:
         emit_json(record)
         return
@@ -48,21 +51,26 @@ def sweep(
     out_dir: OutDir,
     workers: Workers = CORES,
     dask: Dask = None,
+    max_runs: Annotated[
+        int, typer.Option(min=1, help="Refuse a sweep of more runs than this.")
+    ] = MAX_RUNS,
+    force: Force = False,
     as_json: JsonFlag = False,
 ) -> None:
     """Run every config of a sweep, skipping finished runs; writes results.parquet."""
-    from articula.runs.records import make_folder
-    from articula.runs.runner import RESULTS, check_backend, run_sweep
+    from articula.runs.backends import check_backend
+    from articula.runs.folders import check_out
+    from articula.runs.runner import RESULTS, run_sweep
     from articula.runs.sweep import expand_sweep
     from articula.validation import load_toml
 
-    configs = expand_sweep(load_toml(spec), spec.parent)
     check_backend(dask)
-    make_folder(out_dir)
+    configs = expand_sweep(load_toml(spec), spec.parent, max_runs)
+    check_out(out_dir, "sweep", force)
     with progress_bar(as_json) as bar:
         task = bar.add_task("sweep", total=len(configs))
         table = run_sweep(
-            configs, out_dir, workers=workers, dask=dask,
+            configs, out_dir, workers=workers, dask=dask, force=force,
             progress=lambda done, total: bar.update(task, completed=done),
         )  # fmt: skip
     summary = {"runs": table.num_rows, "results": str(out_dir / RESULTS)}

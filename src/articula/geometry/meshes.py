@@ -9,6 +9,7 @@ import trimesh
 
 from articula.errors import GeometryError
 from articula.geometry.shapes import ConvexShape, convex_hull
+from articula.limits import MAX_DECOMPOSE_VERTICES, MAX_LENGTH, MAX_SCALE, MIN_SCALE
 
 FORMATS = (".stl", ".obj", ".ply", ".dae")
 
@@ -34,22 +35,41 @@ def load_mesh(path: Path, scale: float | tuple[float, float, float] = 1.0) -> tr
     if not np.all(np.isfinite(vertices)):
         raise GeometryError(f"{path}: vertices contain NaN or infinite values")
     factor = np.broadcast_to(np.asarray(scale, dtype=float), (3,))
-    if not np.all(np.isfinite(factor)) or np.any(factor == 0):
-        raise GeometryError(f"{path}: scale must be finite and non-zero (got {scale})")
+    if not np.all((np.abs(factor) >= MIN_SCALE) & (np.abs(factor) <= MAX_SCALE)):
+        raise GeometryError(
+            f"{path}: scale must be within ±[{MIN_SCALE:g}, {MAX_SCALE:g}] (got {scale})"
+        )
+    scaled = vertices * factor
+    if not np.all(np.abs(scaled) <= MAX_LENGTH):
+        raise GeometryError(
+            f"{path}: scaled vertices reach {np.abs(scaled).max():.3g} m, beyond ±{MAX_LENGTH:g} "
+            "m; check the scale and the file's units"
+        )
     # Processing merges the duplicate corners of STL triangle soups into a connected mesh.
-    return trimesh.Trimesh(vertices * factor, np.asarray(loaded.faces), process=True)
+    return trimesh.Trimesh(scaled, np.asarray(loaded.faces), process=True)
 
 
 def convex_parts(
-    mesh: trimesh.Trimesh, name: str, decompose: bool = False, threshold: float = 0.05
+    mesh: trimesh.Trimesh,
+    name: str,
+    decompose: bool = False,
+    threshold: float = 0.05,
+    max_vertices: int = MAX_DECOMPOSE_VERTICES,
 ) -> list[ConvexShape]:
     """Convex pieces standing for `mesh`: its hull, or a CoACD decomposition when `decompose`.
 
     The hull is conservative (every point of the mesh is inside it). The decomposition follows
-    concavities more tightly, to within `threshold` (CoACD's concavity bound, relative).
+    concavities more tightly, to within `threshold` (CoACD's concavity bound, relative); it
+    refuses a mesh of more than `max_vertices` vertices, whose decomposition would run for long.
     """
     if not decompose:
         return [convex_hull(mesh.vertices, name)]
+    if len(mesh.vertices) > max_vertices:
+        raise GeometryError(
+            f"{name}: {len(mesh.vertices):,} vertices are more than the {max_vertices:,} a "
+            f"decomposition takes; simplify the mesh, or raise max_vertices (to "
+            f"{len(mesh.vertices)}) and expect a long run"
+        )
     try:
         import coacd
     except ImportError:

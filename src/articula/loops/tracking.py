@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from articula.errors import ConfigError, InfeasibleError
+from articula.limits import MAX_STEPS
 from articula.planning.planner import Planner
 from articula.robots.model import RobotModel
 
@@ -29,13 +30,29 @@ class PlanResult:
 
 
 def track(
-    planner: Planner, trajectory: Trajectory, q0: np.ndarray, dt: float, duration: float
+    planner: Planner,
+    trajectory: Trajectory,
+    q0: np.ndarray,
+    dt: float,
+    duration: float,
+    max_steps: int = MAX_STEPS,
+    progress: Callable[[int, int], None] | None = None,
 ) -> PlanResult:
-    """Follow `trajectory` from q0 [rad] for `duration` [s], one planner step per `dt` [s]."""
+    """Follow `trajectory` from q0 [rad] for `duration` [s], one planner step per `dt` [s].
+
+    A run of more than `max_steps` periods is refused before anything is allocated;
+    `progress(done, total)` is told about every hundredth of the run.
+    """
     if not (np.isfinite(dt) and dt > 0):
         raise ConfigError("dt", f"must be finite and > 0 s (got {dt})")
     if not (np.isfinite(duration) and duration >= dt):
         raise ConfigError("duration", f"must be finite and at least dt = {dt} s (got {duration})")
+    if duration / dt > max_steps:
+        raise ConfigError(
+            "duration",
+            f"{duration:g} s at dt = {dt:g} s is more than max_steps = {max_steps} periods; "
+            "shorten it, raise dt or raise max_steps",
+        )
     scene, robot = planner.scene, planner.scene.robot
     q = robot.check_q(q0, "q0").copy()
     if np.any(q < robot.lower) or np.any(q > robot.upper):
@@ -57,7 +74,10 @@ def track(
     x_ref = np.empty((steps, 3))
     clearance = np.full(steps, np.inf)
     planner_seconds = 0.0
+    every = max(1, steps // 100)
     for n, tn in enumerate(t):
+        if progress is not None and n % every == 0:
+            progress(n, steps)
         x_ref[n] = trajectory(tn)
         start = time.perf_counter()
         q = planner.step(q, x_ref[n], tn)

@@ -8,6 +8,7 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
+from articula.limits import MAX_STEPS
 from articula.planning.baornn import Baornn, BaornnParams
 from articula.planning.baornn_improved import ImprovedBaornn, ImprovedParams
 from articula.planning.objective import Objective
@@ -17,9 +18,18 @@ from articula.planning.trajectories import Circle, Waypoints, rectangle
 from articula.planning.velocity_ik import VelocityIk, VelocityIkParams
 from articula.scene.config import resolve_path
 from articula.scene.scene import Scene
-from articula.validation import Finite, NonNegative, Positive, StrictModel, field_error, fields_as
+from articula.validation import (
+    Finite,
+    NonNegative,
+    Point,
+    Positive,
+    PositiveLength,
+    Seed,
+    StrictModel,
+    field_error,
+    fields_as,
+)
 
-Vec3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
 Method = Literal["baornn", "baornn-improved", "pinv", "dls", "qp"]
 
 
@@ -27,13 +37,13 @@ class TrajectorySpec(StrictModel):
     """[trajectory]: circle (Eq. 1.27), rectangle, waypoints or csv."""
 
     type: Literal["circle", "rectangle", "waypoints", "csv"]
-    center: Vec3 | None = None
-    axis_a: Vec3 | None = None
-    axis_b: Vec3 | None = None
-    radius: Positive | None = None
+    center: Point | None = None
+    axis_a: Point | None = None
+    axis_b: Point | None = None
+    radius: PositiveLength | None = None
     period: Positive | None = None
-    vertices: list[Vec3] | None = None
-    points: list[Vec3] | None = None
+    vertices: list[Point] | None = None
+    points: list[Point] | None = None
     times: list[Finite] | None = None
     path: str | None = None
 
@@ -77,10 +87,19 @@ class PlannerSpec(StrictModel):
     repulsion: NonNegative = 0.02
     influence: Positive = 0.15
     safety: NonNegative = 0.03
-    seed: Annotated[int, Field(ge=0)] | None = None
+    seed: Seed | None = None
+    max_steps: Annotated[int, Field(ge=1, le=10**9)] = MAX_STEPS  # refuse longer runs
 
     @model_validator(mode="after")
     def _times(self) -> PlannerSpec:
+        steps = self.duration / self.dt
+        if steps > self.max_steps:
+            raise field_error(
+                "duration",
+                f"{self.duration:g} s at dt = {self.dt:g} s is {steps:.3g} control periods, more "
+                f"than max_steps = {self.max_steps}; shorten duration, raise dt or raise "
+                "planner.max_steps",
+            )
         if self.settle is None:
             object.__setattr__(self, "settle", min(5.0, self.duration / 2))
         if self.settle >= self.duration:

@@ -11,16 +11,25 @@ import pinocchio as pin
 from articula.errors import InfeasibleError
 from articula.robots.model import RobotModel
 
+# Pinocchio's joints that only rotate about their origin: revolute about an axis, unaligned,
+# unbounded (continuous), spherical.
+ROTATING = frozenset({
+    "JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned",
+    "JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModelRevoluteUnboundedUnaligned",
+    "JointModelSpherical", "JointModelSphericalZYX",
+})  # fmt: skip
+
 
 def reach_sphere(robot: RobotModel) -> tuple[np.ndarray, float] | None:
     """(centre [m], radius [m]) of a sphere containing every end-effector position, or None.
 
     For a chain of revolute joints, the distance between successive joint origins (and from
     the last joint to the end effector) is fixed, so the end effector stays within their sum
-    of the first joint's origin. A prismatic joint has no such bound.
+    of the first joint's origin. A joint that translates (prismatic along an axis, PX/PY/PZ,
+    or unaligned; planar; free) has no such bound.
     """
     model, data = robot.model, robot.model.createData()
-    if any("Prismatic" in joint.shortname() for joint in model.joints[1:]):
+    if not all(joint.shortname() in ROTATING for joint in model.joints[1:]):
         return None
     pin.framesForwardKinematics(model, data, pin.neutral(model))
     points = [data.oMi[j].translation for j in range(1, model.njoints)]

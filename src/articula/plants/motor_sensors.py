@@ -8,20 +8,18 @@ from typing import Annotated
 from pydantic import Field, model_validator
 
 from articula.numba_cache import jit
-from articula.validation import StrictModel
-
-PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+from articula.validation import NonNegative, Positive, StrictModel
 
 
 class CurrentSensorParams(StrictModel):
     """ACS712-5A read by the Arduino's ADC; `ideal` bypasses noise and quantisation."""
 
     ideal: bool = False
-    sensitivity: PositiveFloat = 0.185  # [V/A], ACS712-5A datasheet
-    zero_voltage: PositiveFloat = 2.5  # [V] output at 0 A
-    noise_pp: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.021  # [V] peak-to-peak
+    sensitivity: Positive = 0.185  # [V/A], ACS712-5A datasheet
+    zero_voltage: Positive = 2.5  # [V] output at 0 A
+    noise_pp: NonNegative = 0.021  # [V] peak-to-peak
     adc_bits: Annotated[int, Field(ge=1, le=24)] = 10
-    adc_vref: PositiveFloat = 5.0  # [V]
+    adc_vref: Positive = 5.0  # [V]
 
     @model_validator(mode="after")
     def _zero_inside_adc_range(self) -> CurrentSensorParams:
@@ -41,7 +39,7 @@ class EncoderParams(StrictModel):
     """Shaft encoder; speed is the count difference over a window of samples."""
 
     ideal: bool = False
-    counts_per_rev: Annotated[int, Field(ge=1)] = 375
+    counts_per_rev: Annotated[int, Field(ge=1, le=1_000_000_000)] = 375
     window: Annotated[int, Field(ge=1, le=100_000)] = 50  # samples (50 ms at 1 kHz)
 
 

@@ -8,7 +8,7 @@ import numpy as np
 from pydantic import Field
 from scipy.spatial.transform import Rotation
 
-from articula.validation import StrictModel
+from articula.validation import NonNegative, StrictModel
 
 
 class OrientationSensorParams(StrictModel):
@@ -20,7 +20,7 @@ class OrientationSensorParams(StrictModel):
 
     ideal: bool = False
     rate: Annotated[float, Field(gt=0, le=10_000, allow_inf_nan=False)] = 100.0  # [Hz]
-    noise_deg: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.1  # [deg]
+    noise_deg: NonNegative = 0.1  # [deg]
 
 
 def euler_from_bend(beta: np.ndarray) -> np.ndarray:

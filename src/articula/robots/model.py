@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import math
+import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import dataclass
 from importlib import resources
@@ -13,6 +13,8 @@ import pinocchio as pin
 
 from articula.errors import ConfigError, ModelError
 from articula.geometry.shapes import ConvexShape
+from articula.limits import MAX_ANGLE, MAX_LENGTH, MAX_LINKS
+from articula.native import captured_output
 from articula.robots.urdf_geometry import collision_shapes
 
 BUILTIN = {"iiwa14": ("iiwa14/iiwa14.urdf", "iiwa_link_ee")}
@@ -43,17 +45,34 @@ class RobotModel:
 
     @classmethod
     def from_urdf(
-        cls, path: str | Path, package_dirs: Sequence[str | Path] = (), ee_frame: str | None = None
+        cls,
+        path: str | Path,
+        package_dirs: Sequence[str | Path] = (),
+        ee_frame: str | None = None,
+        max_links: int = MAX_LINKS,
     ) -> RobotModel:
-        """Load kinematics and collision shapes; `ee_frame` defaults to the last link."""
+        """Load kinematics and collision shapes.
+
+        Args:
+            path: the URDF file.
+            package_dirs: folders that hold the packages its package:// meshes name.
+            ee_frame: the end-effector frame; default the last link.
+            max_links: refuse a URDF with more links (checked before anything is built).
+        """
         urdf = Path(path)
         if not urdf.is_file():
             raise ConfigError("urdf", f"{urdf}: file not found")
-        try:
-            model = pin.buildModelFromUrdf(str(urdf))
-        except (RuntimeError, ValueError) as exc:
-            raise ModelError(f"{urdf}: Pinocchio cannot build the model ({exc})") from None
+        _check_size(urdf, max_links)
+        with captured_output() as printed:  # the parser prints warnings past sys.stdout
+            try:
+                model = pin.buildModelFromUrdf(str(urdf))
+            except (RuntimeError, ValueError) as exc:
+                said = f"; it said: {printed[0]}" if printed else ""
+                raise ModelError(
+                    f"{urdf}: Pinocchio cannot build the model ({exc}){said}"
+                ) from None
         _check_serial(model, urdf)
+        _check_magnitudes(model, urdf)
         shapes = collision_shapes(urdf, [Path(d) for d in package_dirs])
         links = []
         for name, items in shapes.items():
@@ -69,15 +88,14 @@ class RobotModel:
         return cls(model, links, ee_frame)
 
     @classmethod
-    def builtin(cls, name: str) -> RobotModel:
-        """A robot shipped with articula: "iiwa14" (KUKA LBR iiwa 14 R820)."""
+    def builtin(cls, name: str, ee_frame: str | None = None) -> RobotModel:
+        """A robot shipped with articula: "iiwa14" (KUKA LBR iiwa 14 R820); `ee_frame`
+        overrides its end-effector frame."""
         if name not in BUILTIN:
-            raise ConfigError(
-                "robot.builtin", f"unknown robot {name!r}; choose one of {sorted(BUILTIN)}"
-            )
-        relative, ee_frame = BUILTIN[name]
+            raise ConfigError("builtin", f"unknown robot {name!r}; choose one of {sorted(BUILTIN)}")
+        relative, default_frame = BUILTIN[name]
         with resources.as_file(resources.files("articula.robots") / "data" / relative) as urdf:
-            return cls.from_urdf(urdf, ee_frame=ee_frame)
+            return cls.from_urdf(urdf, ee_frame=ee_frame or default_frame)
 
     @property
     def nq(self) -> int:
@@ -117,9 +135,12 @@ class RobotModel:
             arr = np.asarray(q, dtype=float)
             if arr.shape != (self.nq,):
                 raise ConfigError(field, f"needs {self.nq} joint values (got shape {arr.shape})")
-        # One dot product catches NaN and ±inf (an overflow only sends us to the exact test).
-        if not math.isfinite(arr @ arr) and not np.all(np.isfinite(arr)):
-            raise ConfigError(field, f"joint values must be finite (got {arr.tolist()})")
+        # One dot product catches NaN, ±inf and huge values (an overflow only sends us to the
+        # exact test), so that only sane numbers reach Pinocchio.
+        if not arr @ arr <= MAX_ANGLE**2 and not np.all(np.abs(arr) <= MAX_ANGLE):
+            raise ConfigError(
+                field, f"joint values must be finite and within ±{MAX_ANGLE:g} (got {arr.tolist()})"
+            )
         return arr
 
     def forward(self, q: np.ndarray) -> None:
@@ -176,6 +197,30 @@ class RobotModel:
 
 def _skew(v: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+def _check_size(urdf: Path, max_links: int) -> None:
+    """ModelError for a URDF with more than `max_links` links, before Pinocchio reads it."""
+    try:
+        links = sum(1 for _, element in ET.iterparse(urdf) if element.tag == "link")
+    except (ET.ParseError, OSError) as exc:
+        raise ModelError(f"{urdf}: cannot read URDF ({exc})") from None
+    if links > max_links:
+        raise ConfigError(
+            "urdf",
+            f"{urdf} has {links} links, more than the limit of {max_links}; raise it with "
+            f"max_links = {links} in [robot]",
+        )
+
+
+def _check_magnitudes(model: pin.Model, urdf: Path) -> None:
+    """ModelError for joint origins or limits no arm has (NaN, inf, beyond the stated limits)."""
+    for name, placement in zip(model.names[1:], model.jointPlacements[1:], strict=True):
+        if not np.all(np.abs(placement.translation) <= MAX_LENGTH):
+            raise ModelError(f"{urdf}: joint {name!r} has its origin beyond ±{MAX_LENGTH:g} m")
+    limits = np.concatenate([model.lowerPositionLimit, model.upperPositionLimit])
+    if not np.all(np.abs(limits) <= MAX_ANGLE):
+        raise ModelError(f"{urdf}: joint limits must be finite and within ±{MAX_ANGLE:g}")
 
 
 def _check_serial(model: pin.Model, urdf: Path) -> None:

@@ -20,11 +20,9 @@ import tomli_w
 
 from articula import __version__
 from articula.errors import ConfigError
+from articula.runs.folders import CONFIG, RECORD, TRACE
 from articula.runs.registry import Result
 
-RECORD = "record.json"
-CONFIG = "config.toml"
-TRACE = "trace.parquet"
 _VERSIONED = (
     "articula", "numpy", "scipy", "numba", "control", "pyarrow", "pydantic",
     "pin", "coal", "trimesh",
@@ -71,10 +69,11 @@ def write_run(
     record: Mapping[str, Any],
     trace: Mapping[str, np.ndarray],
 ) -> None:
-    """Write a complete run folder; record.json goes last and marks the run finished."""
+    """Write a complete run folder; record.json goes last and marks the run finished.
+
+    The caller holds the folder (folders.claimed) or writes into a sweep folder it holds.
+    """
     make_folder(folder)
-    for stale in folder.glob(".*.tmp"):  # left by a run killed while writing
-        stale.unlink(missing_ok=True)
     atomic_write(folder / CONFIG, tomli_w.dumps(dict(config)).encode())
     table = pa.table({k: np.asarray(v) for k, v in trace.items()})
     sink = pa.BufferOutputStream()
@@ -93,9 +92,20 @@ def make_folder(path: Path) -> None:
         raise ConfigError("--out", f"cannot create {path} ({exc.strerror})") from None
 
 
-def is_finished(folder: Path) -> bool:
-    """True when the run folder holds a complete record."""
-    return (folder / RECORD).is_file()
+def is_finished(folder: Path, config_hash_: str | None = None) -> bool:
+    """True when the run folder holds a complete run: a readable record.json (of the config
+    with hash `config_hash_`, when given) beside its config.toml and a readable trace.parquet.
+
+    A folder that fails any check (a run killed between files, a truncated or foreign file)
+    is not finished, and resuming recomputes it.
+    """
+    try:
+        record = read_record(folder)
+        pq.read_metadata(folder / TRACE)
+        complete = (folder / CONFIG).is_file() and isinstance(record.get("metrics"), dict)
+    except (OSError, ValueError, AttributeError, pa.ArrowException):
+        return False
+    return complete and (config_hash_ is None or record.get("config_hash") == config_hash_)
 
 
 def read_record(folder: Path) -> dict[str, Any]:

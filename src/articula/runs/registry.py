@@ -22,6 +22,7 @@ from articula.errors import ConfigError
 from articula.validation import parse_model
 
 GROUP = "articula.experiments"
+Progress = Callable[[int, int], None]  # (done, total) of a run's steps
 
 
 @dataclass(frozen=True)
@@ -44,14 +45,15 @@ class Experiment:
     Attributes:
         name: the value of a config's `experiment` key.
         config: the pydantic model of its config (everything but `experiment`).
-        run: config model -> Result.
+        run: (config model, progress=None) -> Result; a long experiment reports
+            progress(done, total) as it goes, a short one may ignore it.
         resolve_paths: (raw config, folder of its file) -> the config with every file path it
             holds made absolute, so that a run folder's config.toml still finds its files.
     """
 
     name: str
     config: type[BaseModel]
-    run: Callable[[Any], Result]
+    run: Callable[..., Result]
     resolve_paths: Callable[[dict[str, Any], Path], dict[str, Any]] = _no_paths
 
 

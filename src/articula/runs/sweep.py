@@ -4,22 +4,27 @@ from __future__ import annotations
 
 import copy
 import itertools
+import math
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 from articula.errors import ConfigError
+from articula.limits import MAX_RUNS
 from articula.runs import records
 from articula.runs.registry import config_to_dict, parse_config, with_absolute_paths
 
 
-def expand_sweep(spec: Mapping[str, Any], base_dir: Path | None = None) -> list[dict[str, Any]]:
+def expand_sweep(
+    spec: Mapping[str, Any], base_dir: Path | None = None, max_runs: int = MAX_RUNS
+) -> list[dict[str, Any]]:
     """Configs of a sweep: `base` updated by every point of `grid` and every entry of `runs`.
 
     `grid` maps dotted keys ("controller.filter_order") to lists of values and is expanded as a
     Cartesian product; `runs` is a list of partial configs. Every config is validated here, so
     a bad sweep fails before anything runs. File paths in the configs start at `base_dir`
-    (the sweep file's folder) and come out absolute.
+    (the sweep file's folder) and come out absolute. A sweep of more than `max_runs` configs
+    is refused before any is built.
     """
     unknown = set(spec) - {"base", "grid", "runs"}
     if unknown:
@@ -33,9 +38,18 @@ def expand_sweep(spec: Mapping[str, Any], base_dir: Path | None = None) -> list[
         raise ConfigError("grid", 'must be a table of dotted keys to lists ([grid] "a.b" = [...])')
     if not isinstance(runs, list) or not all(isinstance(r, dict) for r in runs):
         raise ConfigError("runs", "must be a list of tables ([[runs]])")
+    if not runs:
+        raise ConfigError("runs", "is empty; give at least one [[runs]] table, or leave it out")
     for key, values in grid.items():
         if not isinstance(values, list) or not values:
             raise ConfigError(f"grid.{key}", "must be a non-empty list of values")
+    size = math.prod(len(values) for values in grid.values()) * len(runs)
+    if size > max_runs:
+        raise ConfigError(
+            "grid",
+            f"the sweep has {size:,} runs, more than the limit of {max_runs:,}; split it, or "
+            f"raise the limit (articula sweep --max-runs {size})",
+        )
     configs = []
     for point in itertools.product(*grid.values()):
         for run in runs:

@@ -12,14 +12,23 @@ from articula.errors import ConfigError, GeometryError
 from articula.geometry.meshes import convex_parts, load_mesh
 from articula.geometry.poses import pose
 from articula.geometry.shapes import ConvexShape, box, capsule, cylinder, sphere
+from articula.limits import MAX_DECOMPOSE_VERTICES, MAX_LINKS, MAX_SCALE, MIN_SCALE
 from articula.robots.model import RobotModel
 from articula.scene.obstacles import Obstacle
 from articula.scene.scene import Metric, Scene
-from articula.validation import Finite, Positive, StrictModel, parse_model
+from articula.validation import (
+    Point,
+    PositiveLength,
+    Radians,
+    StrictModel,
+    fields_as,
+    parse_model,
+)
 
-Vec3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
-PositiveVec3 = Annotated[list[Positive], Field(min_length=3, max_length=3)]
-PositivePair = Annotated[list[Positive], Field(min_length=2, max_length=2)]
+Scale = Annotated[float, Field(ge=MIN_SCALE, le=MAX_SCALE, allow_inf_nan=False)]
+Rpy = Annotated[list[Radians], Field(min_length=3, max_length=3)]
+Sizes3 = Annotated[list[PositiveLength], Field(min_length=3, max_length=3)]
+Sizes2 = Annotated[list[PositiveLength], Field(min_length=2, max_length=2)]
 SHAPE_KEYS = ("mesh", "box", "sphere", "cylinder", "capsule")
 
 
@@ -30,7 +39,8 @@ class RobotSpec(StrictModel):
     urdf: str | None = None
     package_dirs: list[str] = Field(default_factory=list)
     ee_frame: str | None = None
-    q0: list[Finite] | None = None
+    q0: list[Radians] | None = None
+    max_links: Annotated[int, Field(ge=1, le=100_000)] = MAX_LINKS  # refuse larger URDFs
 
     @model_validator(mode="after")
     def _one_source(self) -> RobotSpec:
@@ -44,15 +54,16 @@ class ObstacleSpec(StrictModel):
 
     name: str | None = None
     mesh: str | None = None
-    scale: Positive | PositiveVec3 = 1.0
+    scale: Scale | Annotated[list[Scale], Field(min_length=3, max_length=3)] = 1.0
     decompose: bool = False  # CoACD convex decomposition instead of the hull
-    box: PositiveVec3 | None = None
-    sphere: Positive | None = None
-    cylinder: PositivePair | None = None  # [radius, length]
-    capsule: PositivePair | None = None  # [radius, length]
-    position: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    rpy: Vec3 = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    velocity: Vec3 | None = None  # [m/s]: the obstacle moves at constant velocity
+    max_vertices: Annotated[int, Field(ge=1, le=100_000_000)] = MAX_DECOMPOSE_VERTICES
+    box: Sizes3 | None = None
+    sphere: PositiveLength | None = None
+    cylinder: Sizes2 | None = None  # [radius, length]
+    capsule: Sizes2 | None = None  # [radius, length]
+    position: Point = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    rpy: Rpy = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    velocity: Point | None = None  # [m/s]: the obstacle moves at constant velocity
 
     @model_validator(mode="after")
     def _one_shape(self) -> ObstacleSpec:
@@ -84,14 +95,16 @@ def build_scene(
 ) -> tuple[Scene, np.ndarray]:
     """The Scene and its initial configuration q0; relative paths start at `base_dir`."""
     r = spec.robot
-    if r.builtin is not None:
-        robot = RobotModel.builtin(r.builtin)
-    else:
-        robot = RobotModel.from_urdf(
-            resolve_path(base_dir, r.urdf or ""),
-            [resolve_path(base_dir, d) for d in r.package_dirs],
-            r.ee_frame,
-        )
+    with fields_as({name: f"robot.{name}" for name in RobotSpec.model_fields}):
+        if r.builtin is not None:
+            robot = RobotModel.builtin(r.builtin, r.ee_frame)
+        else:
+            robot = RobotModel.from_urdf(
+                resolve_path(base_dir, r.urdf or ""),
+                [resolve_path(base_dir, d) for d in r.package_dirs],
+                r.ee_frame,
+                r.max_links,
+            )
     q0 = robot.check_q(r.q0 if r.q0 is not None else np.zeros(robot.nq), "robot.q0")
     obstacles = []
     for i, o in enumerate(spec.obstacles):
@@ -108,7 +121,8 @@ def _obstacle(spec: ObstacleSpec, index: int, base_dir: Path) -> Obstacle:
     if spec.mesh is not None:
         mesh_path = resolve_path(base_dir, spec.mesh)
         scale = tuple(spec.scale) if isinstance(spec.scale, list) else spec.scale
-        parts = convex_parts(load_mesh(mesh_path, scale), name, decompose=spec.decompose)
+        mesh = load_mesh(mesh_path, scale)
+        parts = convex_parts(mesh, name, spec.decompose, max_vertices=spec.max_vertices)
     else:
         parts = [_primitive(spec)]
     start = pose(spec.position, spec.rpy)

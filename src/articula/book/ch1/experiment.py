@@ -9,17 +9,17 @@ folder's config.toml re-runs and sweeps like any other experiment's.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Any
 
-from pydantic import Field, model_validator
+from pydantic import model_validator
 
 from articula.errors import ConfigError, InfeasibleError
 from articula.loops.tracking import trace_columns, track, tracking_metrics
 from articula.planning.config import PlannerSpec, TrajectorySpec, make_planner, make_trajectory
 from articula.planning.reach import check_reach
-from articula.runs.registry import Experiment, Result
+from articula.runs.registry import Experiment, Progress, Result
 from articula.scene.config import SceneSpec, build_scene, resolve_path
-from articula.validation import fields_as, load_toml
+from articula.validation import Seed, fields_as, load_toml
 
 NAME = "baornn.plan"
 # Library argument names -> where the user wrote them in a plan config.
@@ -33,7 +33,7 @@ class PlanConfig(SceneSpec):
     files), else 0. The validated config holds it once, at the top.
     """
 
-    seed: Annotated[int, Field(ge=0)] | None = None
+    seed: Seed | None = None
     trajectory: TrajectorySpec
     planner: PlannerSpec = PlannerSpec()
 
@@ -45,7 +45,7 @@ class PlanConfig(SceneSpec):
         return self
 
 
-def run_plan(config: PlanConfig) -> Result:
+def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
     """Track the path; metrics of loops.tracking.tracking_metrics and its trace columns.
 
     Relative file paths start at the working folder (a config read from a file has them made
@@ -59,7 +59,7 @@ def run_plan(config: PlanConfig) -> Result:
     with fields_as(_CONFIG_PATHS):
         check_reach(scene.robot, trajectory, p.duration)
         planner = make_planner(p, scene, config.seed or 0)
-        run = track(planner, trajectory, q0, p.dt, p.duration)
+        run = track(planner, trajectory, q0, p.dt, p.duration, p.max_steps, progress)
     metrics = tracking_metrics(run, scene.robot, p.settle or 0.0, planner.iterations)
     if metrics["rms_error"] > p.tolerance:
         raise InfeasibleError(

@@ -16,9 +16,9 @@ from pydantic import Field, model_validator
 from articula.control.pid import PID, GainSchedule
 from articula.loops.pneunet_pid import ClosedLoopTrace, run_closed_loop
 from articula.plants.pneunet import PneuNetParams
-from articula.runs.registry import Experiment, Result
+from articula.runs.registry import Experiment, Progress, Result
 from articula.tuning.response import tracking_error, tuning_cost
-from articula.validation import NonNegative, Positive, StrictModel, field_error
+from articula.validation import NonNegative, Positive, Seed, StrictModel, field_error
 
 Angle = Annotated[float, Field(ge=0, le=90, allow_inf_nan=False)]  # [°], the book's range
 GainRow = Annotated[list[NonNegative], Field(min_length=3, max_length=3)]
@@ -90,7 +90,7 @@ class ControllerConfig(StrictModel):
 class PneuNetPidConfig(StrictModel):
     """`trials` runs of one controller on the PneuNet, each with its own noise seed."""
 
-    seed: Annotated[int, Field(ge=0)] = 0  # trial i draws its noise from seed + i
+    seed: Seed = 0  # trial i draws its noise from seed + i
     trials: Annotated[int, Field(ge=1, le=MAX_TRIALS)] = 25
     duration: Positive = 40.0  # [s]
     settle: NonNegative = 0.0  # [s] before E is taken (0: every sample, as Eq. 2.7)
@@ -159,7 +159,7 @@ def trial_metrics(config: PneuNetPidConfig, trace: ClosedLoopTrace) -> dict[str,
     }
 
 
-def run_pneunet_pid(config: PneuNetPidConfig) -> Result:
+def run_pneunet_pid(config: PneuNetPidConfig, progress: Progress | None = None) -> Result:
     """Simulate every trial; metrics are E's median and quartiles over trials, trace is trial 0."""
     trace = simulate_trials(config)
     m = trial_metrics(config, trace)

@@ -19,7 +19,7 @@ from articula.plants.pneunet import PneuNetParams
 from articula.tuning.coordinate_descent import DescentResult, coordinate_descent
 from articula.tuning.manual import ManualResult, ManualSettings, manual_tuning
 from articula.tuning.response import Response, readonly, step_features, tuning_cost
-from articula.validation import Positive, StrictModel
+from articula.validation import Positive, Seed, StrictModel
 
 GainVector = Annotated[list[Positive], Field(min_length=3, max_length=3)]
 SUBRANGES = (15.0, 45.0, 75.0)  # representative points of [0,30), [30,60), [60,90] (Sect. 2.4.2.1)
@@ -29,7 +29,7 @@ SEQUENCE = (15.0, 45.0, 75.0, 90.0)  # whole-range tuning sequence (Fig. 2.6a)
 class ManualConfig(StrictModel):
     """The scripted manual procedure: one step experiment per trial, `hold` seconds long."""
 
-    seed: Annotated[int, Field(ge=0)] = 1000
+    seed: Seed = 1000
     hold: Positive = 10.0  # [s]
     band: Positive = 2.0  # [°] noise band about a level
     tolerance: Positive = 1.0  # [°] acceptable steady-state error
@@ -38,7 +38,7 @@ class ManualConfig(StrictModel):
 class AutoConfig(StrictModel):
     """Coordinate descent (Algorithm 1): random K and dK, stop on |dK|_1 < k_stop or N sweeps."""
 
-    seed: Annotated[int, Field(ge=0)] = 2000
+    seed: Seed = 2000
     hold: Positive = 4.0  # [s] per level of the reference
     k_stop: Positive = 0.05
     max_iterations: Annotated[int, Field(ge=1, le=10_000)] = 30

@@ -11,8 +11,8 @@ from articula.control.damping import DampingPolicy
 from articula.loops.six_chamber import Deactuation, deactuate, valve_program
 from articula.plants.orientation_sensor import OrientationSensorParams
 from articula.plants.six_chamber import CHAMBERS, SixChamberParams, chamber_directions
-from articula.runs.registry import Experiment, Result
-from articula.validation import Positive, StrictModel, field_error
+from articula.runs.registry import Experiment, Progress, Result
+from articula.validation import Positive, Seed, StrictModel, field_error
 
 RECORD_DT = 1e-3  # [s] trace sample interval
 
@@ -28,7 +28,7 @@ class DeactuationConfig(StrictModel):
     band about rest.
     """
 
-    seed: Annotated[int, Field(ge=0)] = 0
+    seed: Seed = 0
     dt: Annotated[float, Field(gt=0, le=1e-3, allow_inf_nan=False)] = 1e-4
     hold: Positive = 1.5
     after: Positive = 2.0
@@ -130,7 +130,7 @@ def _opposite_peak(run: Deactuation) -> float:
     return float(run.sim.gauge[after][:, far].max())
 
 
-def run_deactuation(config: DeactuationConfig) -> Result:
+def run_deactuation(config: DeactuationConfig, progress: Progress | None = None) -> Result:
     """Simulate one run; metrics on the sensor signal and the truth, trace at 1 kHz."""
     run = simulate_deactuation(config)
     sim = run.sim

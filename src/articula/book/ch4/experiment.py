@@ -11,8 +11,8 @@ from articula.loops.motor_current import LoopSettings, MetricWindow, simulate_lo
 from articula.plants.dc_motor import PRESETS, MotorParams, feedforward_voltage
 from articula.plants.motor_rig import discretize, rig_matrices
 from articula.plants.motor_sensors import CurrentSensorParams, EncoderParams
-from articula.runs.registry import Experiment, Result
-from articula.validation import Finite, NonNegative, Positive, StrictModel
+from articula.runs.registry import Experiment, Progress, Result
+from articula.validation import Finite, NonNegative, Positive, Seed, StrictModel
 
 MAX_STEPS = 10_000_000
 MIN_STEADY_SAMPLES = 10
@@ -52,7 +52,7 @@ class PwmConfig(StrictModel):
 class CurrentControlConfig(StrictModel):
     """One closed-loop current-control run of Sect. 4.4."""
 
-    seed: Annotated[int, Field(ge=0)] = 0
+    seed: Seed = 0
     rig: Literal["single", "dual"] = "dual"
     preset: Literal["table4.1", "table4.2"] = "table4.2"
     motor: MotorParams | None = None  # overrides `preset` when given
@@ -81,13 +81,14 @@ class CurrentControlConfig(StrictModel):
                 f"{MIN_STEADY_SAMPLES} samples; lengthen duration or shorten settle"
             )
         ref = self.reference
-        peak = ref.current + ref.amplitude
-        needed = feedforward_voltage(self.params, peak, ref.speed)  # Eq. (4.13) at the peak
-        if self.rig == "dual" and needed > self.pwm.v_max:
-            raise ValueError(
-                f"reference: {peak:g} A at {ref.speed:g} rad/s needs {needed:.3g} V, more than "
-                f"v_max = {self.pwm.v_max:g} V; lower reference.current, amplitude or speed"
-            )
+        for extreme in (ref.current + ref.amplitude, ref.current - ref.amplitude):
+            needed = feedforward_voltage(self.params, extreme, ref.speed)  # Eq. (4.13)
+            if abs(needed) > self.pwm.v_max:
+                raise ValueError(
+                    f"reference: {extreme:g} A at {ref.speed:g} rad/s needs {needed:.3g} V, more "
+                    f"than the v_max = {self.pwm.v_max:g} V the driver gives; lower "
+                    "reference.current, amplitude or speed"
+                )
         if ref.amplitude > 0 and ref.frequency > 0:
             period = 2 * np.pi / ref.frequency
             if self.duration - self.settle < period:
@@ -208,7 +209,7 @@ def metrics_from_sums(
     return m
 
 
-def run_current_control(config: CurrentControlConfig) -> Result:
+def run_current_control(config: CurrentControlConfig, progress: Progress | None = None) -> Result:
     """Simulate one run and return its metrics and trace."""
     channels, metrics = simulate_batch(config, trials=1)
     trace = {"t": time_axis(config), **{k: v[0] for k, v in (channels or {}).items()}}

@@ -17,6 +17,8 @@ from articula.plants.dc_motor import (
 )
 from articula.validation import load_toml, parse_model
 
+MAX_OPERATING = 1e6  # [V, N·m, A]: far beyond any motor, far below an overflow
+
 
 def load_params(preset: str | None, params_file: Path | None) -> MotorParams:
     """Motor constants from a preset name or a TOML file with keys R, K, b, J, L."""
@@ -32,8 +34,10 @@ def load_params(preset: str | None, params_file: Path | None) -> MotorParams:
 def analyze(p: MotorParams, voltage: float, torque: float, current: float) -> dict[str, Any]:
     """A, B, poles, G(s), steady state at (V, τ_ex) and ω_c at (V, i) for motor `p`."""
     for name, value in (("--voltage", voltage), ("--torque", torque), ("--current", current)):
-        if value != value or value in (float("inf"), float("-inf")):
-            raise ConfigError(name, f"must be a finite number (got {value})")
+        if not abs(value) <= MAX_OPERATING:
+            raise ConfigError(
+                name, f"must be a finite number within ±{MAX_OPERATING:g} (got {value})"
+            )
     A, B = state_space(p)
     omega, i = steady_state(p, voltage, torque)
     eig = poles(p)

@@ -1,0 +1,88 @@
+"""Where a sweep's runs execute: in this process, a local process pool, or Dask."""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import signal
+import sys
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from typing import Any, TypeVar
+
+from articula.errors import ConfigError
+
+T = TypeVar("T")
+PR_SET_PDEATHSIG = 1  # linux/prctl.h
+
+
+def check_backend(dask: str | None) -> None:
+    """Reject a --dask value that is neither 'local' nor a tcp:// address."""
+    if dask is not None and dask != "local" and not dask.startswith("tcp://"):
+        raise ConfigError("--dask", f"expected 'local' or tcp://HOST:PORT (got {dask!r})")
+
+
+def execute_all(
+    task: Callable[[Mapping[str, Any]], T],
+    configs: Sequence[Mapping[str, Any]],
+    workers: int,
+    dask: str | None,
+) -> Iterator[T]:
+    """task(config) for every config, yielded in completion order from the chosen backend."""
+    if not configs:
+        return
+    if dask is not None:
+        yield from _execute_dask(task, configs, dask, workers)
+    elif workers <= 1:
+        for cfg in configs:
+            yield task(cfg)
+    else:
+        parent = os.getpid()
+        with ProcessPoolExecutor(workers, initializer=die_with_parent, initargs=(parent,)) as pool:
+            futures = [pool.submit(task, cfg) for cfg in configs]
+            for fut in as_completed(futures):
+                yield fut.result()
+
+
+def die_with_parent(parent: int) -> None:
+    """Pool initializer: on Linux the kernel kills this worker when its parent dies (even by
+    SIGKILL), so a killed sweep leaves no worker behind; elsewhere nothing changes."""
+    if sys.platform.startswith("linux"):
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
+        if os.getppid() != parent:  # the parent died before prctl took effect
+            os._exit(1)
+
+
+def _execute_dask(
+    task: Callable[[Mapping[str, Any]], T],
+    configs: Sequence[Mapping[str, Any]],
+    address: str,
+    workers: int,
+) -> Iterator[T]:
+    """Run on Dask: `local` starts a loopback LocalCluster, otherwise join the given scheduler."""
+    try:
+        from distributed import Client, LocalCluster
+        from distributed import as_completed as dask_completed
+    except ImportError:
+        raise ConfigError("--dask", "needs the dask extra: pip install 'articula[dask]'") from None
+    cluster = None
+    if address == "local":
+        cluster = LocalCluster(
+            n_workers=max(workers, 1), threads_per_worker=1, host="127.0.0.1",
+            dashboard_address=None, processes=True,
+        )  # fmt: skip
+        client = Client(cluster)
+    else:
+        try:
+            client = Client(address, timeout="10s")
+        except (OSError, TimeoutError) as exc:
+            raise ConfigError("--dask", f"cannot reach the scheduler at {address}: {exc}") from None
+    try:
+        futures = client.map(task, list(configs), pure=False)
+        for fut in dask_completed(futures):
+            yield fut.result()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
