@@ -10,8 +10,8 @@ import pytest
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 PACKAGE = SRC / "articula"
-# Layer of each top-level package or module; a module imports only lower layers and its own
-# package. The base modules order themselves below.
+# Layer of each top-level package or module, in the order of docs/architecture.md; a module
+# imports only lower layers and its own package.
 LAYERS = {
     "errors": 0,
     "limits": 0,
@@ -21,16 +21,16 @@ LAYERS = {
     "__init__": 1,
     "geometry": 2,
     "plants": 2,
-    "tuning": 2,
     "robots": 3,
-    "control": 3,
     "scene": 4,
-    "planning": 5,
-    "loops": 6,
-    "runs": 7,
-    "book": 8,
-    "cli": 9,
-    "__main__": 10,
+    "control": 5,
+    "tuning": 6,
+    "planning": 7,
+    "loops": 8,
+    "runs": 9,
+    "book": 10,
+    "cli": 11,
+    "__main__": 12,
 }
 MAX_LINES = 400
 

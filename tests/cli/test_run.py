@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import errno
 import json
 import math
+import os
+import subprocess
 import tomllib
 from pathlib import Path
 
@@ -11,7 +14,9 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
+from articula.cli import main
 from articula.runs import records
+from tests.conftest import ARTICULA
 from tests.helpers import hidden_files
 
 RECORD_KEYS = {"experiment", "seed", "config_hash", "metrics", "versions", "wall_time_s"}
@@ -193,3 +198,55 @@ def test_reference_the_supply_cannot_reach_is_rejected(
     # 1.5 A at 5 rad/s needs 1.5·8.35 + 0.4485·5 = 14.8 V, more than the 12 V supply (Eq. 4.13).
     config = write_toml({**tiny_config, "reference": {"current": 1.5}})
     assert "reference" in main_fails("run", config, "--out", tmp_path / "out", "--json")
+
+
+def _full_disk_outcome(out) -> None:
+    """What a full disk must leave: no record, so that nothing takes the run as finished."""
+    assert not (out / records.RECORD).exists()
+    assert not records.is_finished(out)
+    if out.exists():
+        assert hidden_files(out) == []
+
+
+def test_a_full_disk_is_one_line_exit_1_and_no_finished_run(tmp_path, write_toml, tiny_config):
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    mounted = subprocess.run(
+        ["mount", "-t", "tmpfs", "-o", "size=256k", "tmpfs", str(disk)],
+        capture_output=True, check=False,
+    )  # fmt: skip
+    if mounted.returncode != 0:
+        pytest.skip("mounting a tmpfs needs root (CI runs as root); the injected test covers it")
+    try:
+        config = write_toml({**tiny_config, "duration": 20.0, "settle": 1.0})  # ~1.4 MB trace
+        out = disk / "run"
+        proc = subprocess.run(
+            [ARTICULA, "run", str(config), "--out", str(out), "--json"],
+            capture_output=True, text=True, check=False,
+        )  # fmt: skip
+        assert proc.returncode == 1, proc.stderr
+        (line,) = proc.stderr.splitlines()
+        assert line.startswith("error: ") and "No space left on device" in line
+        _full_disk_outcome(out)
+    finally:
+        subprocess.run(["umount", str(disk)], check=False)
+
+
+def test_an_injected_full_disk_is_one_line_exit_1_and_no_finished_run(
+    tmp_path, write_toml, tiny_config, monkeypatch, capsys
+):
+    calls = []
+
+    def fsync(fd):
+        calls.append(fd)
+        if len(calls) == 3:  # config.toml and its folder are on disk; the trace does not fit
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(records.os, "fsync", fsync)
+    out = tmp_path / "run"
+    with pytest.raises(SystemExit) as exc:
+        main(["run", str(write_toml(tiny_config)), "--out", str(out), "--json"])
+    assert exc.value.code == 1
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line == f"error: {out / records.TRACE}: No space left on device"
+    _full_disk_outcome(out)

@@ -295,3 +295,87 @@ def test_sweep_bad_dask_without_json_is_one_line(
     spec = write_toml({"base": tiny_config}, "sweep.toml")
     proc = cli("sweep", spec, "--out", tmp_path / "out", "--dask", "bogus")
     assert_one_line_error(proc, "--dask")
+
+
+def _session_processes(session: int) -> list[int]:
+    """Pids of the live processes of a session (Linux /proc)."""
+    pids = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue  # gone meanwhile
+        if int(fields[3]) == session and fields[0] != "Z":
+            pids.append(int(entry.name))
+    return pids
+
+
+def _wait_until(condition, seconds: float) -> bool:
+    """Poll `condition` until it holds or `seconds` pass (a safety net, not a timing check)."""
+    deadline = time.monotonic() + seconds
+    while not condition():
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.05)
+    return True
+
+
+def test_a_killed_sweep_leaves_no_worker_behind(articula_script, tmp_path):
+    spec = write_spec(tmp_path / "slow.toml", SLOW_SPEC)
+    proc = subprocess.Popen(
+        [articula_script, "sweep", str(spec), "--out", str(tmp_path / "out"), "--workers", "2"],
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
+    )  # fmt: skip
+    try:
+        # The pool's workers are up once a run has finished.
+        assert _wait_until(lambda: bool(_finished(tmp_path / "out")), 600)
+        assert len(_session_processes(proc.pid)) >= 3  # the sweep and its two workers
+        os.kill(proc.pid, signal.SIGKILL)  # the parent only, as an OOM killer would
+        proc.wait()
+        assert _wait_until(lambda: not _session_processes(proc.pid), 10), (
+            f"left behind: {_session_processes(proc.pid)}"
+        )
+    finally:
+        for pid in _session_processes(proc.pid):
+            os.kill(pid, signal.SIGKILL)
+
+
+def test_two_sweeps_into_one_folder_end_in_one_refusal_or_shared_results(articula_script, tmp_path):
+    spec = write_spec(tmp_path / "slow.toml", SLOW_SPEC)
+    out = tmp_path / "out"
+    command = [articula_script, "sweep", str(spec), "--out", str(out), "--workers", "1"]
+    procs = [subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+             for _ in range(2)]  # fmt: skip
+    results = [(p.wait(), p.stdout.read(), p.stderr.read()) for p in procs]
+    for p in procs:
+        p.stdout.close()
+        p.stderr.close()
+    codes = sorted(code for code, _, _ in results)
+    assert codes in ([0, 0], [0, 1]), results
+    for code, _, err in results:
+        assert "Traceback" not in err
+        if code == 1:
+            (line,) = err.splitlines()
+            assert line.startswith("error: --out:") and "another process (pid " in line
+    assert pq.read_table(out / runner.RESULTS).num_rows == SLOW_RUNS
+    assert set(_finished(out)) == {records.config_hash(c) for c in sweep.expand_sweep(SLOW_SPEC)}
+    assert hidden_files(out) == []
+
+
+def test_a_sweep_resumes_past_run_folders_that_were_left_incomplete(sweep_cli, tmp_path):
+    spec = write_spec(tmp_path / "s.toml", SPEC)
+    out = tmp_path / "out"
+    sweep_cli(spec, out)
+    hashes = run_folders(out)
+    (out / hashes[0] / records.TRACE).unlink()  # a run killed between its files
+    (out / hashes[1] / records.RECORD).write_text('{"metrics": ')  # a truncated record
+    (out / hashes[2] / ".record.json.k1ll3d00.tmp").write_text("half")  # a killed write
+    (out / ".results.parquet.k1ll3d00.tmp").write_text("half")
+    written = {h: (out / h / records.RECORD).stat().st_mtime_ns for h in hashes[3:]}
+    sweep_cli(spec, out)
+    for h in hashes[:2]:
+        assert records.is_finished(out / h, h)
+    assert {h: (out / h / records.RECORD).stat().st_mtime_ns for h in hashes[3:]} == written
+    assert hidden_files(out) == []

@@ -78,7 +78,6 @@ def test_settle_defaults_to_five_seconds_or_half_the_run():
     [
         ({"method": "magic"}, "PlannerSpec.method"),
         ({"duration": 2.0, "settle": 2.0}, "PlannerSpec.settle"),
-        ({"safety": 0.2, "influence": 0.1}, "PlannerSpec.safety"),
     ],
 )
 def test_bad_planner_specs_name_the_field(kwargs, field):
@@ -135,3 +134,10 @@ def test_make_trajectory_names_the_trajectory_key_at_fault(tmp_path, table, fiel
     with pytest.raises(ConfigError) as err:
         make_trajectory(TrajectorySpec(**table), tmp_path)
     assert err.value.field == field
+
+
+def test_make_planner_names_the_planner_key_of_a_qp_parameter_at_fault():
+    spec = PlannerSpec(method="qp", safety=0.2, influence=0.1)  # the table alone is fine
+    with pytest.raises(ConfigError) as exc:
+        make_planner(spec, ball([0.4, 0.3, 0.6], 0.1), seed=0)
+    assert exc.value.field == "planner.safety"

@@ -7,7 +7,7 @@ import tomllib
 import pyarrow.parquet as pq
 import pytest
 
-from articula.errors import ConfigError
+from articula.errors import ConfigError, InfeasibleError
 from articula.runs import records, runner, sweep
 from tests.helpers import hidden_files, run_folders
 
@@ -143,3 +143,39 @@ def test_execute_names_the_file_of_a_bad_config():
     with pytest.raises(ConfigError) as err:
         runner.execute({**BASE, "duration": -1.0}, "bad.toml")
     assert err.value.field == "bad.toml: duration"
+
+
+def test_an_infeasible_point_is_recorded_and_the_sweep_goes_on(tmp_path):
+    plan = {
+        "experiment": "baornn.plan",
+        "robot": {"builtin": "iiwa14"},
+        "trajectory": {"type": "waypoints", "points": [[0, 0.6, 0.5], [0, 0.6, 0.6]],
+                       "times": [0.0, 1.0]},
+        "planner": {"method": "qp", "duration": 0.2, "settle": 0.1},
+    }  # fmt: skip
+    configs = sweep.expand_sweep({"base": plan, "grid": {"planner.tolerance": [10.0, 1e-9]}})
+    table = runner.run_sweep(configs, tmp_path / "out")
+    errors = table.column("error").to_pylist()
+    assert errors[0] is None and "tolerance" in errors[1]
+    assert table.column("rms_error").to_pylist()[1] is None
+    failed = tmp_path / "out" / records.config_hash(configs[1])
+    assert records.is_finished(failed)  # the same config fails the same way: not retried
+    assert records.read_record(failed)["error"] == errors[1]
+
+
+def test_results_spread_short_lists_into_columns():
+    flat = runner._flatten({"a": [1.0, 2.0], "b": {"c": [[3, 4]]}, "long": list(range(17))})
+    assert flat == {"a.0": 1.0, "a.1": 2.0, "b.c.0.0": 3, "b.c.0.1": 4}
+
+
+def test_a_run_time_error_names_the_config_file(tmp_path):
+    plan = {
+        "experiment": "baornn.plan",
+        "robot": {"builtin": "iiwa14"},
+        "obstacles": [{"sphere": 0.3, "position": [0.0, 0.0, 0.8]}],  # around the home pose
+        "trajectory": {"type": "waypoints", "points": [[0, 0.6, 0.5], [0, 0.6, 0.6]],
+                       "times": [0.0, 1.0]},
+    }  # fmt: skip
+    with pytest.raises(InfeasibleError) as err:
+        runner.execute(plan, "scene.toml")
+    assert err.value.field == "scene.toml: robot.q0"

@@ -130,3 +130,40 @@ def test_expand_sweep_does_not_mutate_its_input():
     configs = sweep.expand_sweep(spec)
     assert [c["reference"]["frequency"] for c in configs] == [30.0, 40.0]
     assert spec == before
+
+
+def test_a_grid_key_indexes_a_list_of_the_base():
+    plan = {
+        "experiment": "baornn.plan",
+        "robot": {"builtin": "iiwa14"},
+        "obstacles": [{"sphere": 0.05, "position": [0.4, 0.3, 0.6]}],
+        "trajectory": {"type": "waypoints", "points": [[0, 0.6, 0.5], [0, 0.6, 0.6]],
+                       "times": [0.0, 1.0]},
+    }  # fmt: skip
+    configs = sweep.expand_sweep(
+        {"base": plan, "grid": {"obstacles.0.position.2": [0.6, 0.7], "obstacles.0.sphere": [0.1]}}
+    )
+    assert [c["obstacles"][0]["position"] for c in configs] == [[0.4, 0.3, 0.6], [0.4, 0.3, 0.7]]
+    assert plan["obstacles"][0]["position"] == [0.4, 0.3, 0.6]  # the base is untouched
+    with pytest.raises(ConfigError, match="index"):
+        sweep.expand_sweep({"base": plan, "grid": {"obstacles.3.sphere": [0.1]}})
+
+
+def test_an_empty_runs_list_is_refused():
+    with pytest.raises(ConfigError) as err:
+        sweep.expand_sweep({"base": BASE, "runs": []})
+    assert err.value.field == "runs"
+
+
+def test_a_sweep_over_the_run_limit_is_refused_before_any_config_is_built():
+    grid = {f"k{i}": list(range(10)) for i in range(10)}  # 10**10 points, never expanded
+    with pytest.raises(ConfigError) as err:
+        sweep.expand_sweep({"base": BASE, "grid": grid}, max_runs=100)
+    assert err.value.field == "grid" and "--max-runs" in err.value.problem
+
+
+def test_an_error_names_the_sweep_file_and_the_point():
+    spec = {"base": BASE, "grid": {"seed": [0], "pwm.bits": [8, 99]}}
+    with pytest.raises(ConfigError) as err:
+        sweep.expand_sweep(spec, where="s.toml")
+    assert err.value.field == "s.toml, seed = 0, pwm.bits = 99: pwm.bits"

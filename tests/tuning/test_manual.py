@@ -26,9 +26,9 @@ def test_ziegler_nichols_rejects_an_unknown_rule_and_a_bad_gain():
 
 
 def test_ladder_values_and_bad_ladder():
-    assert Ladder(1.0, 2.0, 8.0).values() == [1.0, 2.0, 4.0, 8.0]
+    assert Ladder(start=1.0, factor=2.0, stop=8.0).values() == [1.0, 2.0, 4.0, 8.0]
     with pytest.raises(ConfigError):
-        Ladder(1.0, 0.5, 8.0)
+        Ladder(start=1.0, factor=0.5, stop=8.0)
 
 
 def _fake(shape):
@@ -73,7 +73,7 @@ def test_manual_procedure_tries_k_d_even_without_overshoot_and_never_reruns():
     assert (
         result.gains[0]
         == max(t.gains[0] for t in result.trials)
-        == Ladder(0.25, 1.5, 40.0).values()[-1]
+        == Ladder(start=0.25, factor=1.5, stop=40.0).values()[-1]
     )
 
 
@@ -87,7 +87,7 @@ def test_manual_procedure_refuses_a_first_k_p_that_already_swings():
 def test_ultimate_gain_without_sustained_swings_is_infeasible():
     experiment, _ = _fake(lambda t, k: 90.0 * (1 - np.exp(-3 * t)))
     with pytest.raises(InfeasibleError, match="raise the ladder's stop"):
-        ultimate_gain(experiment, Ladder(0.5, 2.0, 4.0), band=2.0)
+        ultimate_gain(experiment, Ladder(start=0.5, factor=2.0, stop=4.0), band=2.0)
 
 
 def _rig(level: float, seconds: float, seed: int = 0) -> SimulatedRig:
@@ -117,6 +117,8 @@ def test_tuning_records_are_read_only():
 
 
 def test_ultimate_gain_finds_a_sustained_oscillation():
-    ku, tu, trials = ultimate_gain(_rig(90.0, 10.0), Ladder(0.5, 1.5, 100.0), band=2.0)
+    ku, tu, trials = ultimate_gain(
+        _rig(90.0, 10.0), Ladder(start=0.5, factor=1.5, stop=100.0), band=2.0
+    )
     assert trials[-1].decision == "sustained" and trials[-1].gains[0] == ku
     assert 0.1 < tu < 2.0

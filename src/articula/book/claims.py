@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import Any, Literal
 
 from articula.errors import ConfigError
@@ -66,7 +66,8 @@ def claims_markdown(claims: Sequence[Claim], heading: str) -> list[str]:
 
 def claims_data(claims: Sequence[Claim]) -> dict[str, Any]:
     """`claims` (name -> reproduced) and `claims_detail` (one object per claim) for --json."""
+    keys = ("name", "book", "ours", "rule", "verdict")  # the title is for the report only
     return {
         "claims": {c.name: c.reproduced for c in claims},
-        "claims_detail": [asdict(c) for c in claims],
+        "claims_detail": [{k: getattr(c, k) for k in keys} for c in claims],
     }

@@ -65,7 +65,7 @@ def sweep(
     from articula.validation import load_toml
 
     check_backend(dask)
-    configs = expand_sweep(load_toml(spec), spec.parent, max_runs)
+    configs = expand_sweep(load_toml(spec), spec.parent, max_runs, str(spec))
     check_out(out_dir, "sweep", force)
     with progress_bar(as_json) as bar:
         task = bar.add_task("sweep", total=len(configs))
@@ -73,8 +73,10 @@ def sweep(
             configs, out_dir, workers=workers, dask=dask, force=force,
             progress=lambda done, total: bar.update(task, completed=done),
         )  # fmt: skip
-    summary = {"runs": table.num_rows, "results": str(out_dir / RESULTS)}
+    failed = sum(error is not None for error in table.column("error").to_pylist())
+    summary = {"runs": table.num_rows, "failed": failed, "results": str(out_dir / RESULTS)}
     if as_json:
         emit_json(summary)
     else:
-        out.print(f"{summary['runs']} runs; results in {summary['results']}")
+        note = f" ({failed} could not be done: see the error column)" if failed else ""
+        out.print(f"{summary['runs']} runs{note}; results in {summary['results']}")

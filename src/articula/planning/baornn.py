@@ -26,7 +26,7 @@ class BaornnParams(StrictModel):
 
     c1: Positive = 0.5
     c2: Positive = 0.5
-    iterations_per_step: Annotated[int, Field(ge=1, le=1_000_000)] = 10
+    iterations_per_step: Annotated[int, Field(ge=1, le=10_000)] = 10
 
 
 @dataclass

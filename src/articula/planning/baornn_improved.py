@@ -27,7 +27,7 @@ class ImprovedParams(BaornnParams):
     """BaornnParams with λ_k = c1·√e_k [rad/√m] instead of (1.23), and `pairs`, the antenna
     pairs per iteration."""
 
-    pairs: Annotated[int, Field(ge=1, le=1_000_000)] = 3
+    pairs: Annotated[int, Field(ge=1, le=64)] = 3
 
 
 @dataclass

@@ -104,13 +104,21 @@ class PlannerSpec(StrictModel):
             object.__setattr__(self, "settle", min(5.0, self.duration / 2))
         if self.settle >= self.duration:
             raise field_error("settle", f"must be shorter than duration = {self.duration} s")
-        if self.safety >= self.influence:
-            raise field_error("safety", f"must be smaller than influence = {self.influence} m")
         return self
 
 
 def make_planner(spec: PlannerSpec, scene: Scene, seed: int) -> Planner:
-    """The planner a PlannerSpec names, on `scene`, its randomness drawn from `seed`."""
+    """The planner a PlannerSpec names, on `scene`, its randomness drawn from `seed`.
+
+    The method's own parameter model checks what only it needs (a QP's safety distance inside
+    its influence distance); its errors name the [planner] key.
+    """
+    with fields_as(PARAMETER_KEYS):
+        return _planner(spec, scene, seed)
+
+
+def _planner(spec: PlannerSpec, scene: Scene, seed: int) -> Planner:
+    """make_planner without the renaming of its errors."""
     rng = np.random.default_rng(seed)
     objective = Objective(scene, spec.lambda_weight, spec.beta, spec.d_min)
     if spec.method == "baornn":
@@ -126,6 +134,14 @@ def make_planner(spec: PlannerSpec, scene: Scene, seed: int) -> Planner:
     velocity = VelocityIkParams(gain=spec.gain, damping=spec.damping, repulsion=spec.repulsion,
                                 influence=spec.influence)  # fmt: skip
     return VelocityIk(scene, spec.method, spec.dt, velocity, spec.d_min)
+
+
+# "QpIkParams.safety" -> "planner.safety": the library's names of the [planner] keys.
+PARAMETER_KEYS = {
+    f"{model.__name__}.{name}": f"planner.{name}"
+    for model in (BaornnParams, ImprovedParams, QpIkParams, VelocityIkParams)
+    for name in model.model_fields
+} | {f"Objective.{name}": f"planner.{name}" for name in ("lambda_weight", "beta", "d_min")}
 
 
 def make_trajectory(spec: TrajectorySpec, base_dir: Path) -> Circle | Waypoints:

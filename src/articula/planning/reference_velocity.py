@@ -17,7 +17,7 @@ class RateParams(StrictModel):
     """
 
     gain: NonNegative = 20.0
-    influence: NonNegative = 0.15
+    influence: Positive = 0.15
     speed_scale: Positive = 1.0
 
 

@@ -51,9 +51,12 @@ def package_versions() -> dict[str, str]:
     return versions
 
 
-def build_record(config: Mapping[str, Any], result: Result, wall_time: float) -> dict[str, Any]:
-    """The JSON-ready record of one run."""
-    return {
+def build_record(
+    config: Mapping[str, Any], result: Result, wall_time: float, error: str | None = None
+) -> dict[str, Any]:
+    """The JSON-ready record of one run; `error` says why a run of a sweep could not be done
+    (its metrics are then empty)."""
+    record = {
         "experiment": config["experiment"],
         "seed": config.get("seed"),
         "config_hash": config_hash(config),
@@ -61,6 +64,9 @@ def build_record(config: Mapping[str, Any], result: Result, wall_time: float) ->
         "versions": package_versions(),
         "wall_time_s": wall_time,
     }
+    if error is not None:
+        record["error"] = error
+    return record
 
 
 def write_run(
@@ -136,6 +142,11 @@ def atomic_write(path: Path, data: bytes) -> None:
             os.fsync(f.fileno())
         os.chmod(tmp, 0o644)  # mkstemp creates 0600; results are meant to be shared
         os.replace(tmp, path)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        if exc.filename:
+            raise
+        raise OSError(exc.errno, exc.strerror, str(path)) from None  # name the file
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
@@ -143,6 +154,8 @@ def atomic_write(path: Path, data: bytes) -> None:
     dir_fd = os.open(path.parent, os.O_RDONLY)
     try:
         os.fsync(dir_fd)
+    except OSError as exc:
+        raise OSError(exc.errno, exc.strerror, str(path)) from None
     finally:
         os.close(dir_fd)
 

@@ -68,12 +68,13 @@ def names() -> list[str]:
     return sorted(_entry_points())
 
 
-def experiment(name: str) -> Experiment:
-    """The installed experiment called `name`."""
+def experiment(name: str, where: str = "") -> Experiment:
+    """The installed experiment called `name`; the error for an unknown one names `where`."""
     entry = _entry_points().get(name)
     if entry is None:
         known = ", ".join(names()) or "none installed (pip install -e . registers them)"
-        raise ConfigError("experiment", f"unknown experiment {name!r}; choose one of: {known}")
+        field = f"{where}: experiment" if where else "experiment"
+        raise ConfigError(field, f"unknown experiment {name!r}; choose one of: {known}")
     found = entry.load()
     if not isinstance(found, Experiment) or found.name != name:
         raise ConfigError("experiment", f"entry point {entry.value} is not the Experiment {name!r}")
@@ -86,8 +87,8 @@ def parse_config(data: Mapping[str, Any], where: str = "") -> tuple[Experiment, 
     body = dict(data)
     if "experiment" not in body:
         field = f"{where}: experiment" if where else "experiment"
-        raise ConfigError(field, 'required key is missing (e.g. experiment = "motor.current")')
-    exp = experiment(str(body.pop("experiment")))
+        raise ConfigError(field, f"required key is missing; one of: {', '.join(names())}")
+    exp = experiment(str(body.pop("experiment")), where)
     return exp, parse_model(exp.config, body, where)
 
 

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -11,10 +12,13 @@ from typing import Any
 import numpy as np
 import pyarrow as pa
 
+from articula.errors import ConfigError, InfeasibleError
 from articula.runs import records
 from articula.runs.backends import check_backend, execute_all
 from articula.runs.folders import RESULTS, check_out, claimed
-from articula.runs.registry import Progress, config_to_dict, parse_config
+from articula.runs.registry import Progress, Result, config_to_dict, parse_config
+
+FLAT_LIST_LIMIT = 16  # results.parquet spreads a config list this long or shorter into columns
 
 
 @dataclass(frozen=True)
@@ -34,9 +38,41 @@ def execute(
     exp, model = parse_config(config, where)
     full = config_to_dict(exp, model)
     start = time.perf_counter()
-    result = exp.run(model, progress=progress)
+    with named_by_file(where):
+        result = exp.run(model, progress=progress)
     wall = time.perf_counter() - start
     return RunOutput(full, records.build_record(full, result, wall), result.trace)
+
+
+@contextmanager
+def named_by_file(where: str) -> Iterator[None]:
+    """Prefix the field of a ConfigError or InfeasibleError raised inside with `where` (the
+    config's file), as validation errors are."""
+    try:
+        yield
+    except ConfigError as exc:
+        if not where:
+            raise
+        raise ConfigError(f"{where}: {exc.field}", exc.problem) from None
+    except InfeasibleError as exc:
+        if not where:
+            raise
+        raise InfeasibleError(
+            exc.problem, f"{where}: {exc.field}" if exc.field else where
+        ) from None
+
+
+def execute_or_fail(config: Mapping[str, Any]) -> RunOutput:
+    """execute(config), or, for a config that cannot be done (InfeasibleError: a start in
+    collision, a path out of reach), a run whose record says why, so that one such point
+    of a sweep does not stop the others; resuming does not retry it (the same config fails
+    the same way)."""
+    try:
+        return execute(config)
+    except InfeasibleError as exc:
+        full = normalized(config)
+        record = records.build_record(full, Result({}, {}), 0.0, error=str(exc))
+        return RunOutput(full, record, {})
 
 
 def normalized(config: Mapping[str, Any]) -> dict[str, Any]:
@@ -89,7 +125,7 @@ def run_sweep(
         done = len(configs) - len(todo)
         if progress:
             progress(done, len(configs))
-        for output in execute_all(execute, todo, workers, dask):
+        for output in execute_all(execute_or_fail, todo, workers, dask):
             folder = out / output.record["config_hash"]
             records.write_run(folder, output.config, output.record, output.trace)
             done += 1
@@ -101,22 +137,25 @@ def run_sweep(
 
 
 def results_table(configs: Sequence[Mapping[str, Any]], out: Path) -> pa.Table:
-    """One row per run: its hash, flattened config values and metrics."""
+    """One row per run: its hash, flattened config values, metrics, and `error` (null, or why
+    the run could not be done)."""
     rows = []
     for cfg in configs:
         h = records.config_hash(cfg)
         record = records.read_record(out / h)
-        row = {"run": h, **_flatten(cfg), **record["metrics"], "wall_time_s": record["wall_time_s"]}
-        rows.append(row)
+        row = {"run": h, **_flatten(cfg), **record["metrics"]}
+        rows.append({**row, "wall_time_s": record["wall_time_s"], "error": record.get("error")})
     return pa.Table.from_pylist(rows)
 
 
-def _flatten(cfg: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
-    """Dotted keys for nested tables; values that are not scalars are left out."""
+def _flatten(cfg: Mapping[str, Any] | list[Any], prefix: str = "") -> dict[str, Any]:
+    """Scalars by dotted key, as a sweep's [grid] names them ("obstacles.0.position.1"); lists
+    longer than FLAT_LIST_LIMIT (a waypoint list) are left out."""
+    items = cfg.items() if isinstance(cfg, Mapping) else enumerate(cfg)
     flat: dict[str, Any] = {}
-    for k, v in cfg.items():
+    for k, v in items:
         key = f"{prefix}{k}"
-        if isinstance(v, Mapping):
+        if isinstance(v, Mapping) or (isinstance(v, list) and len(v) <= FLAT_LIST_LIMIT):
             flat.update(_flatten(v, key + "."))
         elif isinstance(v, (int, float, str, bool)):
             flat[key] = v

@@ -16,7 +16,10 @@ from articula.runs.registry import config_to_dict, parse_config, with_absolute_p
 
 
 def expand_sweep(
-    spec: Mapping[str, Any], base_dir: Path | None = None, max_runs: int = MAX_RUNS
+    spec: Mapping[str, Any],
+    base_dir: Path | None = None,
+    max_runs: int = MAX_RUNS,
+    where: str = "",
 ) -> list[dict[str, Any]]:
     """Configs of a sweep: `base` updated by every point of `grid` and every entry of `runs`.
 
@@ -24,7 +27,7 @@ def expand_sweep(
     Cartesian product; `runs` is a list of partial configs. Every config is validated here, so
     a bad sweep fails before anything runs. File paths in the configs start at `base_dir`
     (the sweep file's folder) and come out absolute. A sweep of more than `max_runs` configs
-    is refused before any is built.
+    is refused before any is built. Errors name `where` (the sweep file) and the point.
     """
     unknown = set(spec) - {"base", "grid", "runs"}
     if unknown:
@@ -52,13 +55,15 @@ def expand_sweep(
         )
     configs = []
     for point in itertools.product(*grid.values()):
-        for run in runs:
+        for index, run in enumerate(runs):
             cfg = _deep_merge(base, run)
             for key, value in zip(grid, point, strict=True):
                 _set_dotted(cfg, key, value)
             if base_dir is not None:
                 cfg = with_absolute_paths(cfg, base_dir)
-            configs.append(config_to_dict(*parse_config(cfg)))
+            values = ", ".join(f"{k} = {v!r}" for k, v in zip(grid, point, strict=True))
+            label = ", ".join(p for p in (where, values, f"runs[{index}]" * (len(runs) > 1)) if p)
+            configs.append(config_to_dict(*parse_config(cfg, label)))
     hashes = [records.config_hash(c) for c in configs]
     if len(set(hashes)) != len(hashes):
         raise ConfigError("grid", "two points of the sweep give the same config; remove the repeat")
@@ -66,22 +71,37 @@ def expand_sweep(
 
 
 def _deep_merge(a: Mapping[str, Any], b: Mapping[str, Any]) -> dict[str, Any]:
-    """Nested copy of `a` with `b` laid over it."""
-    merged = {k: (dict(v) if isinstance(v, Mapping) else v) for k, v in a.items()}
+    """A deep copy of `a` with `b` laid over it (tables merged, everything else replaced)."""
+    merged = copy.deepcopy(dict(a))
     for k, v in b.items():
         if isinstance(v, Mapping) and isinstance(merged.get(k), Mapping):
             merged[k] = _deep_merge(merged[k], v)
         else:
-            merged[k] = v
+            merged[k] = copy.deepcopy(v)
     return merged
 
 
 def _set_dotted(cfg: dict[str, Any], key: str, value: Any) -> None:
-    """Set cfg["a"]["b"] for key "a.b", creating tables as needed."""
-    *parents, leaf = key.split(".")
-    node = cfg
-    for part in parents:
-        node = node.setdefault(part, {})
-        if not isinstance(node, dict):
-            raise ConfigError(f"grid.{key}", f"{part!r} is not a table in the base config")
-    node[leaf] = value
+    """Set cfg["a"]["b"] for key "a.b", creating tables as needed; a number indexes a list
+    of the base config ("obstacles.0.position" is the first obstacle's position)."""
+    parts = key.split(".")
+    node: Any = cfg
+    for depth, part in enumerate(parts):
+        if isinstance(node, list):
+            if not (part.isdigit() and int(part) < len(node)):
+                raise ConfigError(
+                    f"grid.{key}", f"{part!r} is not an index of the base's list of {len(node)}"
+                )
+            slot: Any = int(part)
+        elif isinstance(node, dict):
+            slot = part
+        else:
+            raise ConfigError(
+                f"grid.{key}", f"{parts[depth - 1]!r} is neither a table nor a list in the base"
+            )
+        if depth == len(parts) - 1:
+            node[slot] = value
+        elif isinstance(node, dict):
+            node = node.setdefault(slot, {})
+        else:
+            node = node[slot]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from importlib import resources
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -30,6 +31,7 @@ Rpy = Annotated[list[Radians], Field(min_length=3, max_length=3)]
 Sizes3 = Annotated[list[PositiveLength], Field(min_length=3, max_length=3)]
 Sizes2 = Annotated[list[PositiveLength], Field(min_length=2, max_length=2)]
 SHAPE_KEYS = ("mesh", "box", "sphere", "cylinder", "capsule")
+PACKAGE_URI = "package://articula/"  # a file shipped inside articula
 
 
 class RobotSpec(StrictModel):
@@ -151,6 +153,10 @@ def _primitive(spec: ObstacleSpec) -> ConvexShape:
 
 
 def resolve_path(base_dir: Path, text: str) -> Path:
-    """A path from a scene file: `~` expanded, relative ones taken from `base_dir`."""
+    """A path from a scene file: `package://articula/...` inside the installed package (the
+    same config then finds its files on any machine), `~` expanded, relative ones taken from
+    `base_dir`."""
+    if text.startswith(PACKAGE_URI):
+        return Path(str(resources.files("articula").joinpath(text.removeprefix(PACKAGE_URI))))
     path = Path(text).expanduser()
     return path if path.is_absolute() else base_dir / path

@@ -9,9 +9,10 @@ overshoot without adding swings. Every experiment is kept, for Fig. 2.5.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
+from pydantic import Field, model_validator
 
 from articula.errors import ConfigError, InfeasibleError
 from articula.tuning.response import (
@@ -21,19 +22,21 @@ from articula.tuning.response import (
     readonly,
     step_features,
 )
+from articula.validation import Positive, StrictModel, field_error
 
 
-@dataclass(frozen=True)
-class Ladder:
-    """Values tried in turn: start, start·factor, ... up to at most `stop`."""
+class Ladder(StrictModel):
+    """Values tried in turn: start, start·factor, ... up to at most `stop` (a gain's unit)."""
 
-    start: float
-    factor: float
-    stop: float
+    start: Positive
+    factor: Annotated[float, Field(gt=1, le=1e3, allow_inf_nan=False)]
+    stop: Positive
 
-    def __post_init__(self) -> None:
-        if not (0 < self.start <= self.stop and self.factor > 1):
-            raise ConfigError("ladder", f"need 0 < start <= stop and factor > 1 (got {self})")
+    @model_validator(mode="after")
+    def _ordered(self) -> Ladder:
+        if self.stop < self.start:
+            raise field_error("stop", f"must be at least start = {self.start} (got {self.stop})")
+        return self
 
     def values(self) -> list[float]:
         """The rungs, smallest first."""
@@ -71,19 +74,24 @@ class ManualResult:
         object.__setattr__(self, "gains", readonly(self.gains))
 
 
-@dataclass(frozen=True)
-class ManualSettings:
-    """Ladders and tolerances of the procedure (units of the response: degrees in chapter 2)."""
+class ManualSettings(StrictModel):
+    """Ladders and tolerances of the procedure (units of the response: degrees in chapter 2).
 
-    kp: Ladder = Ladder(0.25, 1.5, 40.0)
-    ki: Ladder = Ladder(0.1, 1.5, 40.0)
-    kd: Ladder = Ladder(0.01, 2.0, 1.0)
-    band: float = 2.0  # noise band about a level
-    tolerance: float = 1.0  # acceptable steady-state error
+    Attributes:
+        kp, ki, kd: the rungs tried for each gain.
+        band: the noise band about a level; swings inside it do not count.
+        tolerance: the acceptable steady-state error.
+    """
+
+    kp: Ladder = Ladder(start=0.25, factor=1.5, stop=40.0)
+    ki: Ladder = Ladder(start=0.1, factor=1.5, stop=40.0)
+    kd: Ladder = Ladder(start=0.01, factor=2.0, stop=1.0)
+    band: Positive = 2.0
+    tolerance: Positive = 1.0
 
 
 def manual_tuning(
-    experiment: GainExperiment, settings: ManualSettings = ManualSettings()
+    experiment: GainExperiment, settings: ManualSettings | None = None
 ) -> ManualResult:
     """Sect. 2.3.2.1 scripted: K_p to converging swings, K_i to zero error, K_d for overshoot.
 
@@ -93,6 +101,7 @@ def manual_tuning(
     steady-state error still within tolerance. Raises InfeasibleError if the smallest K_p
     already gives swings that grow or persist (the procedure has no K_p to keep).
     """
+    settings = settings or ManualSettings()
     trials: list[Trial] = []
 
     def run(gains: list[float]) -> StepFeatures:

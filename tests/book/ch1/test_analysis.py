@@ -6,8 +6,16 @@ import pytest
 
 from articula.book.ch1 import analysis
 from articula.book.ch1.analysis import AVERAGED, claims, colliding_methods, comparison
-from articula.book.ch1.book_values import BOOK_RUN_OF_SCENE, BOOK_RUNS, GUARDED, SCENES, UNGUARDED
-from articula.book.ch1.study import FULL_SEEDS, METHODS, comparison_runs
+from articula.book.ch1.book_values import (
+    BOOK_RUN_OF_SCENE,
+    BOOK_RUNS,
+    FULL_SEEDS,
+    GUARDED,
+    METHODS,
+    SCENES,
+    UNGUARDED,
+)
+from articula.book.ch1.study import comparison_runs
 
 
 def _metrics(value=lambda run: 0.0) -> dict[str, dict[str, float]]:

@@ -85,11 +85,8 @@ def test_a_start_inside_d_min_is_refused_naming_robot_q0():
         ({"method": "magic"}, ("planner", "method", "magic")),
         ({"settle": 2.0}, ("planner", "settle", "duration")),
         ({"settle": 3.0}, ("planner", "settle", "duration")),
-        ({"safety": 0.15}, ("planner", "safety", "influence")),
-        ({"safety": 0.2, "influence": 0.1}, ("planner", "safety", "influence")),
     ],
-    ids=["unknown_method", "settle_equals_duration", "settle_after_end", "safety_equals_influence",
-         "safety_beyond_influence"],
+    ids=["unknown_method", "settle_equals_duration", "settle_after_end"],
 )  # fmt: skip
 def test_bad_planner_tables_are_config_errors_naming_the_file(planner, words):
     with pytest.raises(ConfigError) as err:
@@ -102,17 +99,28 @@ def test_bad_planner_tables_are_config_errors_naming_the_file(planner, words):
 
 @pytest.mark.parametrize(
     ("planner", "field"),
-    [
-        ({"method": "magic"}, "planner.method"),
-        ({"settle": 2.0}, "planner.settle"),
-        ({"safety": 0.15}, "planner.safety"),
-    ],
-    ids=["method", "settle", "safety"],
+    [({"method": "magic"}, "planner.method"), ({"settle": 2.0}, "planner.settle")],
+    ids=["method", "settle"],
 )
 def test_bad_planner_fields_are_named_with_their_dotted_path(planner, field):
     with pytest.raises(ConfigError) as err:
         _config(_data(**planner))
     assert field in err.value.field
+
+
+@pytest.mark.parametrize(
+    "planner", [{"safety": 0.15}, {"safety": 0.2, "influence": 0.1}], ids=["equal", "beyond"]
+)
+def test_a_qp_safety_distance_outside_its_influence_is_refused_naming_the_planner_key(planner):
+    with pytest.raises(ConfigError) as err:
+        run_plan(_config(_data(**planner)))
+    assert err.value.field == "planner.safety" and "influence" in err.value.problem
+
+
+def test_keys_a_method_does_not_use_are_not_checked_against_each_other():
+    # baornn has no safety distance, so an influence below the default safety is fine.
+    data = _data(method="baornn", influence=0.01, duration=0.05, settle=0.02, tolerance=10.0)
+    assert run_plan(_config(data)).metrics["settle_s"] == 0.02
 
 
 def test_the_seed_is_held_once_at_the_top():

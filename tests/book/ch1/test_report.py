@@ -7,8 +7,8 @@ import re
 
 from articula.book.ch1 import report
 from articula.book.ch1.analysis import AVERAGED
-from articula.book.ch1.book_values import BOOK_RUNS, SCENES, SNAPSHOTS
-from articula.book.ch1.study import METHODS
+from articula.book.ch1.book_values import BOOK_RUNS, METHODS, SCENES, SNAPSHOTS
+from articula.book.ch1.study import Ch1Results
 
 HEADINGS = (
     "### Figs. 1.4-1.12: the faithful BAORNN (Algorithm 1)",
@@ -25,7 +25,11 @@ def _made_up() -> tuple[dict, dict]:
 
 def test_the_markdown_formats_made_up_numbers_without_running_anything(section):
     metrics, table = _made_up()
-    md = report.markdown(metrics, table, {}, full=False)
+    settings = {"d_min": 0.002, "pairs": 3, "gain": 20.0, "repulsion": 0.02, "influence": 0.15,
+                "safety": 0.03, "dt": 0.01, "iterations_per_step": 10, "c1": 0.3, "c2": 0.5,
+                "beta": 1.0, "settle": 5.0}  # fmt: skip
+    md = report.markdown(Ch1Results(metrics, {}, {}, settings), table, full=False)
+    assert "d_min = 0.002 m" in md and "K = 20/s" in md
     assert all(h in md for h in HEADINGS)
     for run in BOOK_RUNS:
         assert f"| {run.title} | 1.00 | 1.00 | 1.0 (1.0) |" in md

@@ -6,18 +6,16 @@ import tomllib
 
 import pyarrow.parquet as pq
 
-from articula.book.ch1.book_values import BOOK_RUNS, SCENES, UNGUARDED
-from articula.book.ch1.study import (
+from articula.book.ch1.book_values import (
+    BOOK_RUNS,
     FULL_SEEDS,
     METHODS,
-    RUNS,
+    SCENES,
     STOCHASTIC,
-    SWEEP,
-    comparison_runs,
-    plan_config,
-    scene_path,
+    UNGUARDED,
     slug,
 )
+from articula.book.ch1.study import RUNS, SWEEP, comparison_runs, plan_config, scene_path
 from articula.book.study import Study, read_metrics, run_folder
 from articula.runs import records
 from articula.runs.runner import normalized

@@ -8,17 +8,17 @@ import re
 import pytest
 
 from articula.book.ch4 import analysis, report
-
-from .conftest import GAINS
+from tests.book.ch4.conftest import GAINS
 
 REPRODUCED = dict.fromkeys(
     (analysis.OMEGA_C, analysis.PER_VOLT, analysis.RISE_TIME, analysis.TRACKS,
      analysis.AMPLITUDE_FALLS, analysis.LAG_GROWS, analysis.FEEDBACK_RISE,
      analysis.CURRENT_RISE, analysis.FILTER_COSTS, analysis.LESS_NOISE,
      analysis.LESS_BANDWIDTH),
-    True,
+    "reproduced",
 )  # fmt: skip
-NONE_REPRODUCED = dict.fromkeys(REPRODUCED, False)
+NONE_REPRODUCED = dict.fromkeys(REPRODUCED, "not reproduced")
+INCONCLUSIVE = dict.fromkeys(REPRODUCED, "inconclusive")
 
 
 def markdown(results, verdicts) -> str:
@@ -92,6 +92,11 @@ def test_explanations_appear_only_where_a_claim_is_not_reproduced(differs, agree
         assert text not in agrees, text
     assert "Tracked closely." in agrees
     assert "falling monotonically." in agrees
+
+
+def test_an_inconclusive_claim_gets_no_explanation_of_a_difference(results):
+    text = markdown(results, INCONCLUSIVE)
+    assert "The constant bias of Eq. (4.13) puts the full voltage" not in text
 
 
 def test_numbers_in_the_explanations_come_from_the_results(results):

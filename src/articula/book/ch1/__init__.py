@@ -14,5 +14,5 @@ def reproduce(study: Study) -> Section:
     results = run_study(study)
     table = analysis.comparison(results.metrics)
     data = {"runs": {r.name: results.metrics[r.name] for r in BOOK_RUNS}, "comparison": table}
-    markdown = report.markdown(results.metrics, table, results.scenes, study.full)
+    markdown = report.markdown(results, table, study.full)
     return Section(markdown, data, tuple(analysis.claims(results.metrics, table)))

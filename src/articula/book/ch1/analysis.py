@@ -8,12 +8,14 @@ from typing import Any
 
 from articula.book.ch1.book_values import (
     BOOK_RUN_OF_SCENE,
+    EQUAL_ITERATIONS,
     GUARDED,
+    METHODS,
     SCENES,
     TWO_OBSTACLE_CLEARANCE,
     UNGUARDED,
+    slug,
 )
-from articula.book.ch1.study import EQUAL_ITERATIONS, METHODS, slug
 from articula.book.claims import Claim, decide
 
 Metrics = Mapping[str, Mapping[str, float]]

@@ -1,4 +1,5 @@
-"""What chapter 1 of the book shows: its runs (Figs. 1.4-1.12) and what it says of each."""
+"""What chapter 1 of the book shows: its runs (Figs. 1.4-1.12) and what it says of each; and
+the design of our comparison of every method beside them."""
 
 from __future__ import annotations
 
@@ -52,3 +53,25 @@ BOOK_RUN_OF_SCENE = {"rectangle": "fig1_5", "circle": "fig1_8", "two obstacles":
 SNAPSHOTS = {"fig1_5": "Fig. 1.7", "fig1_8": "Fig. 1.10"}  # arm snapshots drawn for these runs
 SNAPSHOT_TIMES = (0, 5, 15, 25, 35, 45)  # [s]
 TWO_OBSTACLE_CLEARANCE = 0.05  # [m], Fig. 1.12
+
+
+# Our comparison beyond the book: every method on every scene, at the scene's book Λ.
+# Faithful iterations per period that cost as many objective evaluations as baornn-improved's
+# 10 × (2·3 antenna pairs + 1 step) + 1 warm start = 71: 24 × 3 = 72.
+EQUAL_ITERATIONS = 24
+# Comparison rows: name -> [planner] overrides (each scene's file gives Λ, d_min and the rest).
+METHODS = {
+    "baornn": {"method": "baornn"},
+    "baornn-improved": {"method": "baornn-improved"},
+    "baornn-equal-evaluations": {"method": "baornn", "iterations_per_step": EQUAL_ITERATIONS},
+    "pinv": {"method": "pinv"},
+    "dls": {"method": "dls"},
+    "qp": {"method": "qp"},
+}
+STOCHASTIC = ("baornn", "baornn-improved", "baornn-equal-evaluations")
+FULL_SEEDS = (0, 1, 2, 3, 4)
+
+
+def slug(scene: str) -> str:
+    """A scene name as part of a run name."""
+    return scene.replace(" ", "_")

@@ -18,7 +18,7 @@ from articula.loops.tracking import trace_columns, track, tracking_metrics
 from articula.planning.config import PlannerSpec, TrajectorySpec, make_planner, make_trajectory
 from articula.planning.reach import check_reach
 from articula.runs.registry import Experiment, Progress, Result
-from articula.scene.config import SceneSpec, build_scene, resolve_path
+from articula.scene.config import PACKAGE_URI, SceneSpec, build_scene, resolve_path
 from articula.validation import Seed, fields_as, load_toml
 
 NAME = "baornn.plan"
@@ -58,7 +58,7 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
     p = config.planner
     with fields_as(_CONFIG_PATHS):
         check_reach(scene.robot, trajectory, p.duration)
-        planner = make_planner(p, scene, config.seed or 0)
+        planner = make_planner(p, scene, config.seed)
         run = track(planner, trajectory, q0, p.dt, p.duration, p.max_steps, progress)
     metrics = tracking_metrics(run, scene.robot, p.settle or 0.0, planner.iterations)
     if metrics["rms_error"] > p.tolerance:
@@ -76,7 +76,9 @@ def absolute_paths(data: dict[str, Any], base_dir: Path) -> dict[str, Any]:
     absolute from `base_dir`, so that a run folder's config.toml still finds them."""
 
     def absolute(path: Any) -> Any:
-        return str(resolve_path(base_dir, path).resolve()) if isinstance(path, str) else path
+        if not isinstance(path, str) or path.startswith(PACKAGE_URI):
+            return path  # a package path is the same on every machine
+        return str(resolve_path(base_dir, path).resolve())
 
     out = dict(data)
     if isinstance(data.get("robot"), dict):

@@ -3,23 +3,23 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import Any
 
 from articula.book.ch1.analysis import Metrics, Table, colliding_methods
-from articula.book.ch1.book_values import BOOK_RUNS, SCENES, SNAPSHOTS
-from articula.book.ch1.study import FULL_SEEDS, SWEEP, scene_path
-from articula.planning.config import PlannerSpec
-from articula.scene.scene import Scene
-from articula.validation import load_toml
+from articula.book.ch1.book_values import BOOK_RUNS, FULL_SEEDS, SCENES, SNAPSHOTS
+from articula.book.ch1.study import SWEEP, Ch1Results
 
 
-def markdown(metrics: Metrics, table: Table, scenes: Mapping[str, Scene], full: bool) -> str:
+def markdown(results: Ch1Results, table: Table, full: bool) -> str:
     """The section: the scenes, the book's runs with their figures, the comparison."""
-    lines = _scene_lines(scenes) + _book_lines(metrics) + _comparison_lines(table, full)
-    return "\n".join(lines)
+    p = results.settings
+    lines = _scene_lines(results.obstacles, p) + _book_lines(results.metrics)
+    return "\n".join(lines + _comparison_lines(table, full, p))
 
 
-def _scene_lines(scenes: Mapping[str, Scene]) -> list[str]:
-    p = load_toml(scene_path("rectangle"))["planner"]
+def _scene_lines(
+    obstacles: Mapping[str, list[tuple[str, str, list[float]]]], p: Mapping[str, Any]
+) -> list[str]:
     lines = [
         "The book gives no obstacle shapes or poses; ours (docs/deviations.md) put the obstacles "
         "in the way of the links, not of the end effector, so that only the arm's redundancy "
@@ -35,11 +35,10 @@ def _scene_lines(scenes: Mapping[str, Scene]) -> list[str]:
         "| scene | file | obstacles (mesh at position [m]) |",
         "|---|---|---|",
     ]
-    for name, scene in scenes.items():
-        data = load_toml(scene_path(name))
-        obstacles = ", ".join(f"{o['mesh']} at {o['position']}" for o in data["obstacles"])
-        names = ", ".join(o.name for o in scene.obstacles)
-        lines.append(f"| {name} | `{SCENES[name]}` | {names}: {obstacles} |")
+    for name, items in obstacles.items():
+        names = ", ".join(n for n, _, _ in items)
+        where = ", ".join(f"{mesh} at {position}" for _, mesh, position in items)
+        lines.append(f"| {name} | `{SCENES[name]}` | {names}: {where} |")
     return [*lines, ""]
 
 
@@ -68,20 +67,19 @@ def _book_lines(m: Metrics) -> list[str]:
     return [*lines, ""]
 
 
-def _comparison_lines(table: Table, full: bool) -> list[str]:
+def _comparison_lines(table: Table, full: bool, p: Mapping[str, Any]) -> list[str]:
     seeds = f"mean of seeds {FULL_SEEDS[0]}-{FULL_SEEDS[-1]}" if full else "seed 0 (quick)"
-    p = PlannerSpec()
     lines = [
         "### All methods on all scenes",
         "",
-        f"BAORNN rows use the scene's book Λ and d_min = 0.002 m ({seeds}); baornn-improved "
-        f"uses {p.pairs} antenna pairs per iteration. pinv/dls: resolved-rate control "
-        f"(K = {p.gain:g}/s) with a null-space FIRAS repulsion (η = {p.repulsion:g}, influence "
-        f"{p.influence:g} m); qp: NEO-style velocity dampers (influence {p.influence:g} m, "
-        f"safety {p.safety:g} m) solved by daqp. The baselines are limited to the URDF joint "
-        "speeds; BAORNN, as in the book, is not. Times are of the planner alone (not the "
-        "recording): per period (one control step) and per iteration (BAORNN's inner "
-        "iterations; a baseline's iteration is its period).",
+        f"BAORNN rows use the scene's book Λ and d_min = {p['d_min']:g} m ({seeds}); "
+        f"baornn-improved uses {p['pairs']} antenna pairs per iteration. pinv/dls: resolved-rate "
+        f"control (K = {p['gain']:g}/s) with a null-space FIRAS repulsion (η = "
+        f"{p['repulsion']:g}, influence {p['influence']:g} m); qp: NEO-style velocity dampers "
+        f"(influence {p['influence']:g} m, safety {p['safety']:g} m) solved by daqp. The "
+        "baselines are limited to the URDF joint speeds; BAORNN, as in the book, is not. "
+        "Times are of the planner alone (not the recording): per period (one control step) "
+        "and per iteration (BAORNN's inner iterations; a baseline's iteration is its period).",
         "",
         "| scene | method | RMS error [mm] | max error [mm] | min clearance [mm] | "
         "after settling [mm] | colliding steps | after settling | µs per period | "

@@ -9,38 +9,45 @@ from typing import Any
 
 import tomli_w
 
-from articula.book.ch1.book_values import BOOK_RUNS, SCENES, SNAPSHOT_TIMES, SNAPSHOTS, Run
-from articula.book.ch1.experiment import load_plan
+from articula.book.ch1.book_values import (
+    BOOK_RUNS,
+    FULL_SEEDS,
+    METHODS,
+    SCENES,
+    SNAPSHOT_TIMES,
+    SNAPSHOTS,
+    STOCHASTIC,
+    Run,
+    slug,
+)
+from articula.book.ch1.experiment import NAME
 from articula.book.study import Study, packaged, read_metrics, read_trace
+from articula.planning.config import PlannerSpec
 from articula.runs.records import atomic_write
-from articula.scene.config import build_scene, load_scene_spec
+from articula.scene.config import PACKAGE_URI, build_scene, load_scene_spec
 from articula.scene.scene import Scene
-from articula.validation import load_toml
+from articula.validation import load_toml, parse_model
 
-# Faithful iterations per period that cost as many objective evaluations as baornn-improved's
-# 10 × (2·3 antenna pairs + 1 step) + 1 warm start = 71: 24 × 3 = 72.
-EQUAL_ITERATIONS = 24
-# Comparison rows: name -> [planner] overrides (each scene's file gives Λ, d_min and the rest).
-METHODS = {
-    "baornn": {"method": "baornn"},
-    "baornn-improved": {"method": "baornn-improved"},
-    "baornn-equal-evaluations": {"method": "baornn", "iterations_per_step": EQUAL_ITERATIONS},
-    "pinv": {"method": "pinv"},
-    "dls": {"method": "dls"},
-    "qp": {"method": "qp"},
-}
-STOCHASTIC = ("baornn", "baornn-improved", "baornn-equal-evaluations")
-FULL_SEEDS = (0, 1, 2, 3, 4)
 SWEEP = "plan_sweep.toml"  # the study as a sweep file, written beside the report
 RUNS = "runs"  # its sweep folder
 
 
 @dataclass(frozen=True)
 class Ch1Results:
-    """Metrics of every run by name, and the scenes they ran in."""
+    """What the chapter's report shows.
+
+    Attributes:
+        metrics: every run's metrics, by run name.
+        scenes: the Scene of each of the book's scenes.
+        obstacles: each scene's obstacles as (name, mesh file, position [m]).
+        settings: the complete [planner] table of the runs (a qp run of the rectangle scene:
+            every method's parameters with their defaults filled in).
+    """
 
     metrics: dict[str, dict[str, float]]
     scenes: dict[str, Scene]
+    obstacles: dict[str, list[tuple[str, str, list[float]]]]
+    settings: dict[str, Any]
 
 
 def scene_path(scene: str) -> Path:
@@ -65,10 +72,15 @@ def comparison_runs(full: bool) -> list[Run]:
 def plan_config(run: Run) -> dict[str, Any]:
     """The `baornn.plan` config of a run: its scene file with the run's overrides.
 
-    A seed override goes to the top of the config; the tolerance is lifted so that every
-    result is reported, however large its error, instead of refused.
+    Its meshes are named inside the package (package://articula/...), so that the config, its
+    hash and its run folder are the same on every machine and install; a seed override goes
+    to the top of the config; the tolerance is lifted so that every result is reported,
+    however large its error, instead of refused.
     """
-    data = load_plan(scene_path(run.scene))
+    data = {"experiment": NAME, **load_toml(scene_path(run.scene))}
+    for obstacle in data.get("obstacles", []):
+        if "mesh" in obstacle:
+            obstacle["mesh"] = f"{PACKAGE_URI}book/ch1/configs/{obstacle['mesh']}"
     overrides = dict(run.overrides)
     if "seed" in overrides:
         data["seed"] = overrides.pop("seed")
@@ -87,7 +99,15 @@ def run_study(study: Study) -> Ch1Results:
     metrics = {name: read_metrics(study.out / RUNS, c) for name, c in configs.items()}
     scenes = {name: load_scene(name) for name in SCENES}
     _figures(study.out, configs, scenes)
-    return Ch1Results(metrics, scenes)
+    obstacles = {
+        name: [
+            (o["name"], o["mesh"], o["position"]) for o in load_toml(scene_path(name))["obstacles"]
+        ]
+        for name in SCENES
+    }
+    table = {**load_toml(scene_path("rectangle"))["planner"], "method": "qp"}
+    settings = parse_model(PlannerSpec, table, "planner").model_dump()
+    return Ch1Results(metrics, scenes, obstacles, settings)
 
 
 def load_scene(name: str) -> Scene:
@@ -109,8 +129,3 @@ def _figures(out: Path, configs: Mapping[str, dict[str, Any]], scenes: Mapping[s
         if run.name in SNAPSHOTS:
             title = f"{SNAPSHOTS[run.name]}: snapshots, {run.title.split(': ')[1]}"
             snapshots(scene, trace, list(SNAPSHOT_TIMES), title, out / f"{run.name}_snapshots.png")
-
-
-def slug(scene: str) -> str:
-    """A scene name as part of a run name."""
-    return scene.replace(" ", "_")

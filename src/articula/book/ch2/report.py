@@ -14,6 +14,7 @@ from articula.book.ch2.book_values import (
     SINUSOID_FIGURES,
     TRACKING_LIMIT,
 )
+from articula.book.ch2.kd_analysis import NOISE_ERRORS
 from articula.book.ch2.study import (
     FULL_KEY,
     KD_PROBE,
@@ -222,10 +223,10 @@ def _kd_lines(tuning: Tuning, findings: Findings) -> list[str]:
         "step experiments (the same noise for every K_d), and in brackets the median number of "
         f"swings beyond the {band:g}° band about the levels (and how many of the "
         "experiments swing without dying out). A K_d > 0 is better if it lowers M by more than "
-        "two standard errors of the paired differences, worse if it raises M by as much or "
-        "swings without dying out in most experiments. The claim counts as reproduced only if "
-        "for every set no K_d > 0 is better and some K_d > 0 is worse; not reproduced if some "
-        "K_d > 0 is better for some set; inconclusive otherwise.",
+        f"{NOISE_ERRORS:g} standard errors of the paired differences, worse if it raises M by "
+        "as much or swings without dying out in most experiments. The claim counts as "
+        "reproduced only if for every set no K_d > 0 is better and some K_d > 0 is worse; not "
+        "reproduced if some K_d > 0 is better for some set; inconclusive otherwise.",
         "",
         "| gain set | "
         + " | ".join(f"K_d = {kd:g}" for kd in KD_PROBE)

@@ -43,7 +43,9 @@ Trace = dict[str, np.ndarray]
 FULL_LEVEL = 90.0
 FULL_KEY = f"{FULL_LEVEL:g}"
 MANUAL_LEVELS = (FULL_LEVEL, *SUBRANGES)  # [°] steps of the manual procedure (Table 2.2)
-ZN_LADDER = Ladder(0.25, 1.25, 200.0)  # P-only K_p rungs [counts/°] for the ultimate gain
+ZN_LADDER = Ladder(
+    start=0.25, factor=1.25, stop=200.0
+)  # P-only K_p rungs [counts/°] for the ultimate gain
 ZN_SEED_OFFSET = 90_000  # its rig's noise seed: the manual seed plus this
 KD_PROBE = (0.0, 0.02, 0.05, 0.1, 0.2)  # [counts·s/°] K_d values tried on each tuned gain set
 KD_PROBE_SEEDS = 16

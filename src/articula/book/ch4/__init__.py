@@ -19,7 +19,7 @@ def reproduce(study: Study) -> Section:
     }
     claims = analysis.claims(model, results.runs, results.bandwidth)
     why = analysis.explanations(results.gains, results.runs, results.bandwidth)
-    markdown = report.markdown(results, why, {c.name: c.reproduced for c in claims})
+    markdown = report.markdown(results, why, {c.name: c.verdict for c in claims})
     runs = {
         name: {key: value if key == "k" else num(value) for key, value in m.items()}
         for name, m in results.runs.items()

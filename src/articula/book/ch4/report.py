@@ -7,11 +7,11 @@ from collections.abc import Mapping
 from articula.book.ch4 import analysis as a
 from articula.book.ch4 import book_values as book
 from articula.book.ch4.analysis import Explanations
-from articula.book.ch4.study import SWEEP, Ch4Results, ModelNumbers
+from articula.book.ch4.study import SIMULATED_SECONDS, SWEEP, Ch4Results, ModelNumbers
 from articula.book.text import degrees, milli, significant
 from articula.plants.dc_motor import TABLE_4_1
 
-Verdicts = Mapping[str, bool]  # claim name -> reproduced
+Verdicts = Mapping[str, str]  # claim name -> its verdict
 
 
 def markdown(results: Ch4Results, why: Explanations, verdicts: Verdicts) -> str:
@@ -20,7 +20,7 @@ def markdown(results: Ch4Results, why: Explanations, verdicts: Verdicts) -> str:
     Args:
         results: what the study computed and ran.
         why: the numbers that the explanations of a difference quote.
-        verdicts: claim name -> reproduced; an explanation is shown where a claim is not.
+        verdicts: claim name -> verdict; an explanation is shown where it is "not reproduced".
     """
     lines = _model_lines(results.model, why, verdicts)
     lines += _current_speed_lines(results.model)
@@ -43,7 +43,7 @@ def _model_lines(m: ModelNumbers, why: Explanations, verdicts: Verdicts) -> list
         "Our numbers follow the table; a 120 s simulation of Eq. (4.6) agrees with Eq. (4.8) "
         "to the digits shown."
     )
-    if not verdicts[a.PER_VOLT]:
+    if verdicts[a.PER_VOLT] == "not reproduced":
         follows = (
             f"The book's ω_ss ≈ {book.OMEGA_PER_VOLT:g} V and i_ss ≈ {book.CURRENT_PER_VOLT:g} V "
             f"do not follow from Table 4.1 through Eq. (4.8): with R = {p.R:g} Ω, "
@@ -66,9 +66,11 @@ def _model_lines(m: ModelNumbers, why: Explanations, verdicts: Verdicts) -> list
         "| quantity | book | ours |",
         "|---|---|---|",
         *[f"| {name} | {value:g} | {ours:.5g} |" for name, value, ours in rows],
-        f"| same at 12 V, simulated 120 s from rest (python-control) | — | "
+        f"| same at {book.SUPPLY:g} V, simulated {SIMULATED_SECONDS:g} s from rest "
+        "(python-control) | — | "
         f"ω = {m.simulated_omega:.5g} rad/s, i = {m.simulated_current:.5g} A |",
-        f"| i_ss at 12 V with τ_ex = −0.3 N·m, Eq. (4.10) [A] | > i_ss(τ_ex = 0) | "
+        f"| i_ss at {book.SUPPLY:g} V with τ_ex = {book.LOAD_TORQUE:g} N·m, Eq. (4.10) [A] | "
+        "> i_ss(τ_ex = 0) | "
         f"{m.current_with_load:.4g} |",
         "",
         follows,
@@ -126,7 +128,7 @@ def _run_notes(
         f"- Fig. 4.5 rise time: book ≈ {1e3 * book.RISE_TIME:.0f} ms, ours "
         f"{milli(f5['rise_time'])} ms."
     )
-    if not verdicts[a.RISE_TIME]:
+    if verdicts[a.RISE_TIME] == "not reproduced":
         rise += (
             " The constant bias of Eq. (4.13) puts the full voltage on the motor at once and the "
             "armature time constant L/R is about a millisecond, so the current rises within a "
@@ -137,7 +139,7 @@ def _run_notes(
     tracks = f"- Fig. 4.6, 5 rad/s: amplitude ratio {a6:.3f}, phase lag {degrees(p6)}°."
     tracks += (
         " Tracked closely."
-        if verdicts[a.TRACKS]
+        if verdicts[a.TRACKS] == "reproduced"
         else f" The book shows easy tracking; ours loses {100 * why.tracking_loss:.0f} % because "
         "the loop's −3 dB point is near this frequency (table below): the proportional path "
         f"alone passes only K_p/(K_p + R) = {why.proportional_gain:.2f}, and the integral term "
@@ -147,9 +149,9 @@ def _run_notes(
         f"- Fig. 4.7, 25 rad/s: amplitude ratio {f7['amplitude_ratio']:.3f}, phase lag "
         f"{degrees(f7['phase_lag'])}°."
     )
-    if not verdicts[a.AMPLITUDE_FALLS]:
+    if verdicts[a.AMPLITUDE_FALLS] == "not reproduced":
         fast += " The amplitude does not fall from 5 rad/s."
-    if not verdicts[a.LAG_GROWS]:
+    if verdicts[a.LAG_GROWS] == "not reproduced":
         fast += (
             " The lag is smaller than at 5 rad/s: above the integral corner the loop tends to "
             f"its proportional gain {why.proportional_gain:.2f}, a real number, so the lag peaks "
@@ -161,7 +163,7 @@ def _run_notes(
         f"unfiltered; of the motor current itself {milli(f8['rise_time'])} ms against "
         f"{milli(f5['rise_time'])} ms."
     )
-    if not verdicts[a.CURRENT_RISE]:
+    if verdicts[a.CURRENT_RISE] == "not reproduced":
         filtered += (
             " The feed-forward bias drives the current up regardless of the filter, which only "
             "delays what the controller sees."
@@ -170,7 +172,7 @@ def _run_notes(
         f"- Fig. 4.9 against Fig. 4.6: amplitude ratio {f9['amplitude_ratio']:.3f} vs {a6:.3f}, "
         f"phase lag {degrees(f9['phase_lag'])}° vs {degrees(p6)}°."
     )
-    if not verdicts[a.FILTER_COSTS]:
+    if verdicts[a.FILTER_COSTS] == "not reproduced":
         costs += (
             f" At a 1 kHz loop a moving average of order {why.filter_order} delays the feedback "
             f"by {milli(why.filter_delay)} ms, small against the 1.3 s period, so it does not "
@@ -209,9 +211,13 @@ def _bandwidth_lines(results: Ch4Results, why: Explanations, verdicts: Verdicts)
     text = (
         f"Feedback noise goes from {milli(first.noise)} mA at k = {first.k} to "
         f"{milli(last.noise)} mA at k = {last.k}, "
-        + ("falling monotonically." if verdicts[a.LESS_NOISE] else "not monotonically.")
+        + (
+            "falling monotonically."
+            if verdicts[a.LESS_NOISE] == "reproduced"
+            else "not monotonically."
+        )
     )
-    if verdicts[a.LESS_BANDWIDTH]:
+    if verdicts[a.LESS_BANDWIDTH] == "reproduced":
         text += " The bandwidth falls as k grows."
     else:
         text += (
