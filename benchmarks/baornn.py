@@ -4,7 +4,7 @@
 
 One iteration of Algorithm 1 evaluates the objective at three points (two antennae and the
 candidate), each with the forward kinematics and the minimum link-obstacle distance. Timed at
-200 configurations of a tracking run of configs/ch1/circle_two_obstacles.toml (Λ = 0.005,
+200 configurations of a tracking run of book/ch1/configs/circle_two_obstacles.toml (Λ = 0.005,
 d_min = 0.002 m), one call per configuration in the run's order (so the GJK warm starts are
 those a real run has, never a repeat of the same query), median over the configurations:
   iteration_us        Baornn.step / 10: an iteration as the planner runs it, ten per control
@@ -22,13 +22,12 @@ from __future__ import annotations
 import statistics
 import time
 from collections.abc import Callable
-from importlib import resources
-from pathlib import Path
 
 import numpy as np
 from common import run
 from distance import bare_coal_loop
 
+from articula.book.study import packaged
 from articula.loops.tracking import track
 from articula.planning.baornn import Baornn, BaornnParams
 from articula.planning.objective import Objective
@@ -38,7 +37,7 @@ from articula.validation import load_toml
 
 
 def measure() -> dict[str, float]:
-    path = Path(str(resources.files("articula.book.ch1") / "configs" / "circle_two_obstacles.toml"))
+    path = packaged("ch1", "circle_two_obstacles.toml")
     scene, q0 = build_scene(load_scene_spec(load_toml(path)), path.parent)
     objective = Objective(scene, 0.005, 1.0, 0.002)
     coal_objective = Objective(scene, 0.005, 1.0, 0.002, use_compiled=False)

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import statistics
 import time
-from importlib import resources
 from pathlib import Path
 
 import coal
@@ -27,6 +26,7 @@ import numpy as np
 import pinocchio as pin
 from common import run
 
+from articula.book.study import packaged
 from articula.scene.config import build_scene, load_scene_spec
 from articula.validation import load_toml
 
@@ -35,7 +35,7 @@ REPEATS = 5
 
 
 def _scene_file() -> Path:
-    return Path(str(resources.files("articula.book.ch1") / "configs" / "two_obstacles.toml"))
+    return packaged("ch1", "two_obstacles.toml")
 
 
 def _median_us(fn, Q: np.ndarray) -> float:

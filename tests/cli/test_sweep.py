@@ -322,16 +322,18 @@ def _wait_until(condition, seconds: float) -> bool:
     return True
 
 
-def test_a_killed_sweep_leaves_no_worker_behind(articula_script, tmp_path):
+@pytest.mark.parametrize("backend", [[], ["--dask", "local"]], ids=["pool", "dask"])
+def test_a_killed_sweep_leaves_no_worker_behind(articula_script, tmp_path, backend):
     spec = write_spec(tmp_path / "slow.toml", SLOW_SPEC)
+    command = [articula_script, "sweep", str(spec), "--out", str(tmp_path / "out")]
     proc = subprocess.Popen(
-        [articula_script, "sweep", str(spec), "--out", str(tmp_path / "out"), "--workers", "2"],
+        [*command, "--workers", "2", *backend],
         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
     )  # fmt: skip
     try:
         # The pool's workers are up once a run has finished.
         assert _wait_until(lambda: bool(_finished(tmp_path / "out")), 600)
-        assert len(_session_processes(proc.pid)) >= 3  # the sweep and its two workers
+        assert len(_session_processes(proc.pid)) >= 3  # the sweep and its workers
         os.kill(proc.pid, signal.SIGKILL)  # the parent only, as an OOM killer would
         proc.wait()
         assert _wait_until(lambda: not _session_processes(proc.pid), 10), (

@@ -1,7 +1,8 @@
 """What a chapter's study needs from its surroundings: where to write, how big, which backend.
 
-A chapter runs its experiments through the shared runner (`runs.runner.run_sweep`), so every
-study resumes without recomputing finished runs and runs on a process pool or on Dask.
+A chapter runs its sweeps through the shared runner (`Study.sweep`), so they resume without
+recomputing finished runs and run on a process pool or on Dask; a chapter's searches and
+single what-if runs run in its own process.
 """
 
 from __future__ import annotations
@@ -45,7 +46,7 @@ class Study:
 
     @property
     def size(self) -> str:
-        """ "full" or "quick", the suffix of the packaged sweep files."""
+        """The suffix of the packaged sweep files: "full" or "quick"."""
         return "full" if self.full else "quick"
 
     def sweep(
