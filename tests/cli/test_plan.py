@@ -248,3 +248,14 @@ def test_a_planner_sweep_gives_the_same_runs_on_a_pool_and_on_dask_and_resumes(s
     written = {p: p.stat().st_mtime_ns for p in pool.glob("*/record.json")}
     sweep_cli(spec, pool)
     assert {p: p.stat().st_mtime_ns for p in pool.glob("*/record.json")} == written
+
+
+def test_a_scene_without_obstacles_plans_and_says_so(cli, tmp_path):
+    scene = tmp_path / "free.toml"
+    scene.write_text(
+        '[robot]\nbuiltin = "iiwa14"\n[trajectory]\n' + CIRCLE
+        + '\n[planner]\nmethod = "baornn"\nduration = 0.5\nsettle = 0.2\ntolerance = 10.0\n'
+    )  # fmt: skip
+    proc = cli("plan", scene, "--out", tmp_path / "run")
+    assert proc.returncode == 0, proc.stderr
+    assert "no obstacles" in " ".join(proc.stdout.split())

@@ -198,3 +198,24 @@ def test_decomposing_a_closed_obj_stays_inside_the_mesh(tmp_path):
     every_vertex = np.vstack([p.vertices for p in parts])
     assert _inside(every_vertex, np.asarray(solid.vertices), 1e-6).all()
     assert sum(ConvexHull(p.vertices).volume for p in parts) == pytest.approx(0.006, rel=1e-3)
+
+
+@pytest.mark.parametrize("scale", [1e308, 1e200, 1e-9, (1.0, 1e7, 1.0)])
+def test_a_scale_outside_the_stated_range_is_refused_before_any_hull(tmp_path, scale):
+    path = tmp_path / "t.obj"
+    path.write_text(TETRA)
+    with pytest.raises(GeometryError, match="scale"):
+        load_mesh(path, scale)
+
+
+def test_scaled_vertices_beyond_the_stated_length_are_refused(tmp_path):
+    path = tmp_path / "t.obj"
+    path.write_text(TETRA.replace("1 0 0", "3000 0 0"))
+    with pytest.raises(GeometryError, match="beyond"):
+        load_mesh(path, 10.0)
+
+
+def test_a_decomposition_of_too_many_vertices_is_refused_naming_max_vertices():
+    mesh = trimesh.creation.icosphere(subdivisions=3)  # 642 vertices
+    with pytest.raises(GeometryError, match="max_vertices"):
+        convex_parts(mesh, "ball", decompose=True, max_vertices=100)

@@ -343,3 +343,56 @@ def test_unknown_ee_frame(small_arm):
 def test_continuous_joint_is_rejected(build_edited):
     with pytest.raises(ModelError, match="j2"):
         build_edited('name="j2" type="revolute"', 'name="j2" type="continuous"')
+
+
+def _chain_urdf(links: int) -> str:
+    """A URDF chain of `links` links, each 0.1 m above the last on a revolute joint."""
+    body = "".join(f'<link name="l{i}"/>' for i in range(links))
+    body += "".join(
+        f'<joint name="j{i}" type="revolute"><parent link="l{i}"/><child link="l{i + 1}"/>'
+        '<origin xyz="0 0 0.1"/><axis xyz="0 0 1"/>'
+        '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+        for i in range(links - 1)
+    )
+    return f'<robot name="r">{body}</robot>'
+
+
+def test_a_urdf_over_the_link_limit_is_refused_before_pinocchio_reads_it(tmp_path):
+    path = tmp_path / "long.urdf"
+    path.write_text(_chain_urdf(300))
+    with pytest.raises(ConfigError) as err:
+        RobotModel.from_urdf(path)
+    assert "max_links = 300" in err.value.problem
+    assert RobotModel.from_urdf(path, max_links=300).nq == 299
+
+
+def test_what_the_urdf_parser_prints_ends_up_in_the_one_error(tmp_path, capfd):
+    path = tmp_path / "bad.urdf"
+    path.write_text(
+        '<robot name="r"><link name="a"/><link name="b"/><joint name="j" type="revolute">'
+        '<parent link="a"/><child link="b"/></joint></robot>'
+    )  # a revolute joint without limits: urdfdom prints its complaint on stderr
+    with pytest.raises(ModelError) as err:
+        RobotModel.from_urdf(path)
+    assert "does not specify limits" in str(err.value)
+    assert capfd.readouterr() == ("", "")
+
+
+def test_joint_origins_beyond_the_stated_length_are_refused(tmp_path):
+    path = tmp_path / "far.urdf"
+    path.write_text(_chain_urdf(3).replace('xyz="0 0 0.1"', 'xyz="0 0 1e300"'))
+    with pytest.raises(ModelError, match="origin"):
+        RobotModel.from_urdf(path)
+
+
+def test_joint_values_beyond_the_stated_angle_are_refused():
+    robot = RobotModel.builtin("iiwa14")
+    with pytest.raises(ConfigError, match="within"):
+        robot.check_q([1e308] + [0.0] * 6)
+
+
+def test_the_end_effector_frame_of_the_built_in_robot_can_be_chosen_and_is_checked():
+    assert RobotModel.builtin("iiwa14", "iiwa_link_7").ee_frame == "iiwa_link_7"
+    with pytest.raises(ConfigError) as err:
+        RobotModel.builtin("iiwa14", "nope")
+    assert err.value.field == "ee_frame"

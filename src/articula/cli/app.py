@@ -26,8 +26,10 @@ out = Console()
 JsonFlag = Annotated[bool, typer.Option("--json", help="Print one JSON object and nothing else.")]
 OutDir = Annotated[Path, typer.Option("--out", help="Output folder.")]
 CORES = os.cpu_count() or 1  # default number of local worker processes
+MAX_WORKERS = 1024  # more would only queue
 Workers = Annotated[
-    int, typer.Option(min=1, help="Local worker processes (default: one per core).")
+    int,
+    typer.Option(min=1, max=MAX_WORKERS, help="Local worker processes (default: one per core)."),
 ]
 Force = Annotated[
     bool,

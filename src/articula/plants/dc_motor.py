@@ -2,24 +2,31 @@
 
 from __future__ import annotations
 
+from typing import Annotated
+
 import numpy as np
+from pydantic import Field
 
 from articula.errors import InfeasibleError
-from articula.validation import NonNegative, Positive, StrictModel
+from articula.validation import StrictModel
 
 # The book gives no armature inductance; 10 mH is typical of a 12 V gear-motor with
 # R ≈ 8 Ω and keeps the book's K_p = 10 current loop stable at 1 kHz (docs/deviations.md).
 DEFAULT_INDUCTANCE = 10e-3
 
 
+# Any real motor's constants lie within [1e-9, 1e6] in SI units; beyond, 1/J or R/L overflow.
+Constant = Annotated[float, Field(ge=1e-9, le=1e6, allow_inf_nan=False)]
+
+
 class MotorParams(StrictModel):
     """Motor constants in SI: R [Ω], K = K_t = K_e [N·m/A], b [N·m·s/rad], J [kg·m²], L [H]."""
 
-    R: Positive
-    K: Positive
-    b: NonNegative
-    J: Positive
-    L: Positive = DEFAULT_INDUCTANCE
+    R: Constant
+    K: Constant
+    b: Annotated[float, Field(ge=0, le=1e6, allow_inf_nan=False)]
+    J: Constant
+    L: Constant = DEFAULT_INDUCTANCE
 
 
 # Table 4.1: the single motor.

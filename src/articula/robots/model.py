@@ -63,14 +63,15 @@ class RobotModel:
         if not urdf.is_file():
             raise ConfigError("urdf", f"{urdf}: file not found")
         _check_size(urdf, max_links)
-        with captured_output() as printed:  # the parser prints warnings past sys.stdout
+        failure: Exception | None = None
+        with captured_output() as printed:  # the parser prints its errors past sys.stdout
             try:
                 model = pin.buildModelFromUrdf(str(urdf))
             except (RuntimeError, ValueError) as exc:
-                said = f"; it said: {printed[0]}" if printed else ""
-                raise ModelError(
-                    f"{urdf}: Pinocchio cannot build the model ({exc}){said}"
-                ) from None
+                failure = exc
+        if failure is not None:
+            said = f"; the parser said: {' '.join(printed[:2])}" if printed else ""
+            raise ModelError(f"{urdf}: Pinocchio cannot build the model ({failure}){said}")
         _check_serial(model, urdf)
         _check_magnitudes(model, urdf)
         shapes = collision_shapes(urdf, [Path(d) for d in package_dirs])
@@ -135,9 +136,8 @@ class RobotModel:
             arr = np.asarray(q, dtype=float)
             if arr.shape != (self.nq,):
                 raise ConfigError(field, f"needs {self.nq} joint values (got shape {arr.shape})")
-        # One dot product catches NaN, ±inf and huge values (an overflow only sends us to the
-        # exact test), so that only sane numbers reach Pinocchio.
-        if not arr @ arr <= MAX_ANGLE**2 and not np.all(np.abs(arr) <= MAX_ANGLE):
+        # NaN fails the comparison too: only sane numbers reach Pinocchio.
+        if not np.all(np.abs(arr) <= MAX_ANGLE):
             raise ConfigError(
                 field, f"joint values must be finite and within ±{MAX_ANGLE:g} (got {arr.tolist()})"
             )

@@ -5,6 +5,7 @@ from __future__ import annotations
 import ctypes
 import os
 import signal
+import socket
 import sys
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -14,12 +15,22 @@ from articula.errors import ConfigError
 
 T = TypeVar("T")
 PR_SET_PDEATHSIG = 1  # linux/prctl.h
+CONNECT_TIMEOUT = 3.0  # [s] to reach a Dask scheduler before any work starts
 
 
 def check_backend(dask: str | None) -> None:
-    """Reject a --dask value that is neither 'local' nor a tcp:// address."""
-    if dask is not None and dask != "local" and not dask.startswith("tcp://"):
+    """ConfigError for a --dask value that is neither 'local' nor a reachable tcp://HOST:PORT
+    (tried now, within CONNECT_TIMEOUT, so that a wrong address fails before any work)."""
+    if dask is None or dask == "local":
+        return
+    host, _, port = dask.removeprefix("tcp://").rpartition(":")
+    if not dask.startswith("tcp://") or not host or not port.isdigit():
         raise ConfigError("--dask", f"expected 'local' or tcp://HOST:PORT (got {dask!r})")
+    try:
+        socket.create_connection((host.strip("[]"), int(port)), CONNECT_TIMEOUT).close()
+    except (OSError, ValueError) as exc:
+        reason = getattr(exc, "strerror", None) or str(exc) or type(exc).__name__
+        raise ConfigError("--dask", f"cannot reach the scheduler at {dask} ({reason})") from None
 
 
 def execute_all(
@@ -28,9 +39,11 @@ def execute_all(
     workers: int,
     dask: str | None,
 ) -> Iterator[T]:
-    """task(config) for every config, yielded in completion order from the chosen backend."""
+    """task(config) for every config, yielded in completion order from the chosen backend;
+    never more worker processes than configs."""
     if not configs:
         return
+    workers = min(workers, len(configs))
     if dask is not None:
         yield from _execute_dask(task, configs, dask, workers)
     elif workers <= 1:

@@ -173,3 +173,9 @@ def test_registered_run_returns_trace_columns_of_one_length():
     assert len(lengths) == 1
     assert {"t", "bend", "bend_sensor", "p0", "valve5"} <= set(result.trace)
     assert set(result.metrics) >= {"peak_deg", "overshoot_pct", "settling_s"}
+
+
+def test_a_sensor_too_slow_for_the_time_after_the_vent_command_is_refused():
+    with pytest.raises(ConfigError) as err:
+        DeactuationConfig(hold=0.05, after=0.05, sensor={"rate": 1.0})
+    assert err.value.field == "DeactuationConfig.after" and "sensor.rate" in err.value.problem

@@ -15,6 +15,7 @@ from articula.runs.registry import Experiment, Progress, Result
 from articula.validation import Positive, Seed, StrictModel, field_error
 
 RECORD_DT = 1e-3  # [s] trace sample interval
+MIN_SAMPLES_AFTER = 2  # sensor samples after deactuation: the metrics need a start and a change
 
 
 class DeactuationConfig(StrictModel):
@@ -57,6 +58,13 @@ class DeactuationConfig(StrictModel):
             raise field_error(
                 "dt",
                 f"dt ({self.dt:g} s) must divide the {RECORD_DT:g} s trace interval, e.g. 1e-4",
+            )
+        if self.after * min(self.sensor.rate, 1 / RECORD_DT) < MIN_SAMPLES_AFTER:
+            raise field_error(
+                "after",
+                f"{self.after:g} s after the vent command holds fewer than {MIN_SAMPLES_AFTER} "
+                f"samples at the sensor's {self.sensor.rate:g} Hz; lengthen after or raise "
+                "sensor.rate",
             )
         return self
 
