@@ -250,3 +250,33 @@ def test_an_injected_full_disk_is_one_line_exit_1_and_no_finished_run(
     (line,) = capsys.readouterr().err.splitlines()
     assert line == f"error: {out / records.TRACE}: No space left on device"
     _full_disk_outcome(out)
+
+
+def test_a_folder_of_someone_elses_files_is_refused_and_left_as_it_was(
+    cli, tmp_path, write_toml, tiny_config, assert_one_line_error
+):
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "config.toml").write_text("my own notes")
+    (out / "thesis.tex").write_text("chapter 1")
+    proc = cli("run", write_toml(tiny_config), "--out", out, "--json")
+    assert_one_line_error(proc, "--out", "thesis.tex", "--force")
+    assert (out / "config.toml").read_text() == "my own notes"
+    forced = cli("run", write_toml(tiny_config), "--out", out, "--force", "--json")
+    assert forced.returncode == 0, forced.stderr
+    assert (out / "thesis.tex").read_text() == "chapter 1"
+    assert records.is_finished(out)
+
+
+def test_warnings_of_a_failing_command_do_not_add_lines(monkeypatch, main_fails, tmp_path):
+    from articula.errors import ConfigError
+    from articula.runs import runner
+
+    def warn_then_fail(*args, **kwargs):
+        np.log(np.zeros(1))  # a RuntimeWarning, as numerical code raises
+        raise ConfigError("field", "bad")
+
+    monkeypatch.setattr(runner, "run_to_folder", warn_then_fail)
+    config = tmp_path / "c.toml"
+    config.write_text('experiment = "motor.current"\n')
+    assert main_fails("run", config, "--out", tmp_path / "o") == "error: field: bad"

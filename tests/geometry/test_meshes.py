@@ -219,3 +219,11 @@ def test_a_decomposition_of_too_many_vertices_is_refused_naming_max_vertices():
     mesh = trimesh.creation.icosphere(subdivisions=3)  # 642 vertices
     with pytest.raises(GeometryError, match="max_vertices"):
         convex_parts(mesh, "ball", decompose=True, max_vertices=100)
+
+
+def test_random_bytes_in_an_stl_are_a_geometry_error_not_a_missing_module(tmp_path):
+    path = tmp_path / "noise.stl"
+    path.write_bytes(np.random.default_rng(0).bytes(4096))
+    with pytest.raises(GeometryError) as exc:
+        load_mesh(path)
+    assert "No module named" not in str(exc.value)

@@ -141,3 +141,10 @@ def test_make_planner_names_the_planner_key_of_a_qp_parameter_at_fault():
     with pytest.raises(ConfigError) as exc:
         make_planner(spec, ball([0.4, 0.3, 0.6], 0.1), seed=0)
     assert exc.value.field == "planner.safety"
+
+
+def test_a_run_longer_than_max_steps_is_refused_naming_how_to_raise_it():
+    with pytest.raises(ConfigError) as exc:
+        PlannerSpec(duration=1e9)
+    assert exc.value.field == "PlannerSpec.duration" and "planner.max_steps" in exc.value.problem
+    assert PlannerSpec(duration=2e4, max_steps=2_000_000).duration == 2e4

@@ -166,3 +166,10 @@ def test_streaming_sinusoid_fit_equals_least_squares_on_the_trace():
     np.testing.assert_allclose(m["amplitude_ratio"], amplitude / 0.1, rtol=1e-8)
     np.testing.assert_allclose(m["phase_lag"], -phase, atol=1e-8)
     assert np.all(np.isnan(m["rise_time"]))
+
+
+@pytest.mark.parametrize("current", [-1e308, -1e12, -2.0])
+def test_a_current_the_driver_cannot_reach_either_way_is_refused(current):
+    with pytest.raises(ConfigError) as err:
+        parse_model(CurrentControlConfig, {"reference": {"current": current}})
+    assert "reference" in str(err.value)
