@@ -42,5 +42,10 @@ class ResourceError(ArticulaError, OSError):
     disk, an I/O error, too little memory. The command line exits with status 1 for it."""
 
 
+class CollisionError(ArticulaError, RuntimeError):
+    """A planned motion has colliding steps; its run folder is written, and the command line
+    exits with status 4 unless collisions were allowed."""
+
+
 class DeviceError(ArticulaError, OSError):
     """A bench rig or serial device failed or answered out of protocol."""

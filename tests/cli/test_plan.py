@@ -36,6 +36,7 @@ d_min = 0.002
 duration = 1.0
 settle = 0.5
 seed = 0
+limits = "none"
 """
 CIRCLE = """type = "circle"
 center = [0.0, 0.6, 0.5]
@@ -139,7 +140,8 @@ def method_runs(cli, tmp_path_factory):
 
     def run(method: str):
         out = root / method / "run"
-        return cli("plan", _short_scene(root / method, method), "--out", out, "--json"), out
+        scene = _short_scene(root / method, method)  # pinv and dls may collide here: a study
+        return cli("plan", scene, "--out", out, "--json", "--allow-collisions"), out
 
     with ThreadPoolExecutor(max_workers=min(len(METHODS), os.cpu_count() or 1)) as pool:
         return dict(zip(METHODS, pool.map(run, METHODS), strict=True))
@@ -259,3 +261,22 @@ def test_a_scene_without_obstacles_plans_and_says_so(cli, tmp_path):
     proc = cli("plan", scene, "--out", tmp_path / "run")
     assert proc.returncode == 0, proc.stderr
     assert "no obstacles" in " ".join(proc.stdout.split())
+
+
+def test_a_colliding_motion_writes_its_folder_and_exits_4_unless_allowed(cli, tmp_path):
+    scene = (
+        _short_scene(tmp_path, "pinv")
+        .read_text()
+        .replace("position = [0.35, 0.35, 0.6]", "position = [0.0, 0.2, 0.9]")
+    )  # the ball where the elbow swings through: pinv has no way to keep clear of it
+    path = tmp_path / "colliding.toml"
+    path.write_text(scene)
+    proc = cli("plan", path, "--out", tmp_path / "run", "--json")
+    assert proc.returncode == 4, proc.stderr
+    (line,) = proc.stderr.splitlines()
+    assert line.startswith("error: the motion collides in") and "--allow-collisions" in line
+    record = json.loads(proc.stdout)
+    assert record["metrics"]["collisions"] > 0
+    assert json.loads((tmp_path / "run" / "record.json").read_text()) == record
+    allowed = cli("plan", path, "--out", tmp_path / "run2", "--allow-collisions")
+    assert allowed.returncode == 0, allowed.stderr

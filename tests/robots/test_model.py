@@ -340,9 +340,9 @@ def test_unknown_ee_frame(small_arm):
     assert "gripper" in str(exc.value)
 
 
-def test_continuous_joint_is_rejected(build_edited):
+def test_a_joint_of_two_degrees_of_freedom_is_rejected(build_edited):
     with pytest.raises(ModelError, match="j2"):
-        build_edited('name="j2" type="revolute"', 'name="j2" type="continuous"')
+        build_edited('name="j2" type="revolute"', 'name="j2" type="floating"')
 
 
 def _chain_urdf(links: int) -> str:

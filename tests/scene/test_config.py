@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from articula.errors import ConfigError
 from articula.scene.config import build_scene, load_scene_spec
 from articula.validation import load_toml
 from tests.scene.helpers import box_signed_distance
@@ -93,3 +94,67 @@ def test_moving_sphere_from_toml(tmp_path, write_toml):
     lowest = int(np.argmin(series))
     assert 0 < lowest < len(series) - 1
     assert np.all(np.diff(series[: lowest + 1]) < 0) and np.all(np.diff(series[lowest:]) > 0)
+
+
+# The ball on a continuous yaw joint before its slide, so that one joint can be locked.
+TURN_URDF = BALL_URDF.replace(
+    '<link name="base"/>',
+    '<link name="base"/><joint name="yaw" type="continuous"><parent link="base"/>'
+    '<child link="hub"/><axis xyz="0 0 1"/></joint><link name="hub"/>',
+).replace('<parent link="base"/><child link="ball"/>', '<parent link="hub"/><child link="ball"/>')
+
+
+def test_locked_joints_and_ee_offset_from_toml(tmp_path, write_toml):
+    (tmp_path / "turn.urdf").write_text(TURN_URDF)
+    robot_table = {
+        "urdf": "turn.urdf",
+        "locked_joints": {"yaw": 0.5},
+        "ee_offset": {"xyz": [0.1, 0.0, 0.0], "rpy": [0.0, 0.0, 0.3]},
+        "q0": [0.2],
+    }
+    path = write_toml({"robot": robot_table}, "scene.toml")
+    scene, q0 = build_scene(load_scene_spec(load_toml(path)), tmp_path)
+    robot = scene.robot
+    assert robot.nq == 1 and robot.joint_names == ["slide"]
+    np.testing.assert_array_equal(q0, [0.2])
+    # Tool origin at (0, 0.2, q), yaw π/2; the offset moves 0.1 along the tool's x (world y);
+    # the locked yaw turns all of it by 0.5 about z.
+    c, s = math.cos(0.5), math.sin(0.5)
+    expected = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ [0.0, 0.3, 0.2]
+    np.testing.assert_allclose(robot.ee_position([0.2]), expected, atol=1e-12)
+    yaw = 0.5 + math.pi / 2 + 0.3
+    R = robot.ee_pose([0.2])[:3, :3]
+    np.testing.assert_allclose(R[:2, 0], [math.cos(yaw), math.sin(yaw)], atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("table", "field"),
+    [
+        ({"locked_joints": {"elbow": 0.0}}, "robot.locked_joints.elbow"),
+        ({"locked_joints": {"slide": 2.0}}, "robot.locked_joints.slide"),
+        ({"locked_joints": {"yaw": 7.0}}, "robot.locked_joints.yaw"),
+        ({"locked_joints": {"yaw": 0.0, "slide": 0.0}}, "robot.locked_joints"),
+        ({"ee_frame": "nope", "ee_offset": {"xyz": [0, 0, 0.1]}}, "robot.ee_frame"),
+    ],
+)
+def test_locked_joint_and_ee_offset_errors_name_the_field(tmp_path, write_toml, table, field):
+    (tmp_path / "turn.urdf").write_text(TURN_URDF)
+    path = write_toml({"robot": {"urdf": "turn.urdf", **table}}, "scene.toml")
+    with pytest.raises(ConfigError) as err:
+        build_scene(load_scene_spec(load_toml(path)), tmp_path)
+    assert err.value.field == field
+
+
+@pytest.mark.parametrize(
+    "table",
+    [
+        {"ee_offset": {"xyz": [0.0, 0.0]}},
+        {"ee_offset": {"xyz": [0.0, 0.0, 1e9]}},
+        {"ee_offset": {"rpy": [0.0, 0.0, 0.0], "scale": 2}},
+        {"locked_joints": {"yaw": "half"}},
+    ],
+)
+def test_robot_table_ee_offset_and_locked_joints_are_validated(table):
+    with pytest.raises(ConfigError) as err:
+        load_scene_spec({"robot": {"urdf": "turn.urdf", **table}})
+    assert "robot" in str(err.value)

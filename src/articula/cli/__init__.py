@@ -2,7 +2,8 @@
 
 Exit status: 0 done; 2 bad input (the line names the field or option and the fix); 1 the
 machine stopped the work (disk full, folder in use, I/O error, out of memory); 3 a bug of
-articula's (the line says so; ARTICULA_DEBUG=1 shows the traceback); 130 interrupted.
+articula's (the line says so; ARTICULA_DEBUG=1 shows the traceback); 4 a planned motion
+collides (its run folder is written); 130 interrupted.
 """
 
 from __future__ import annotations
@@ -17,9 +18,9 @@ from typer.exceptions import Abort, Exit, TyperException
 
 from articula.cli import arm, book, runs  # noqa: F401  (each module adds its commands to app)
 from articula.cli.app import app
-from articula.errors import ArticulaError, DeviceError, ResourceError
+from articula.errors import ArticulaError, CollisionError, DeviceError, ResourceError
 
-BAD_INPUT, ENVIRONMENT, BUG, INTERRUPTED = 2, 1, 3, 130
+BAD_INPUT, ENVIRONMENT, BUG, COLLIDES, INTERRUPTED = 2, 1, 3, 4, 130
 # OS errors that the machine causes; every other OSError is about a path the user gave.
 MACHINE_ERRNOS = {errno.ENOSPC, errno.EDQUOT, errno.EIO, errno.EBUSY, errno.ENOMEM,
                   errno.EMFILE, errno.ENFILE, errno.ETXTBSY}  # fmt: skip
@@ -48,6 +49,8 @@ def _status_and_message(exc: Exception) -> tuple[int, str]:
     """The exit status and one-line message of a failure."""
     if isinstance(exc, (ResourceError, DeviceError)):
         return ENVIRONMENT, str(exc)
+    if isinstance(exc, CollisionError):
+        return COLLIDES, str(exc)
     if isinstance(exc, ArticulaError):
         return BAD_INPUT, str(exc)
     if isinstance(exc, Abort):

@@ -27,9 +27,16 @@ def plan(
     ],
     out_dir: OutDir,
     force: Force = False,
+    allow_collisions: Annotated[
+        bool,
+        typer.Option("--allow-collisions", help="Exit 0 even if a step collides (a study)."),
+    ] = False,
     as_json: JsonFlag = False,
 ) -> None:
-    """Track the scene's reference path with its planner; writes a run folder (trace + record)."""
+    """Track the scene's reference path with its planner; writes a run folder (trace + record).
+
+    A motion with a colliding step still writes its run folder, then exits with status 4.
+    """
     from articula.book.ch1.experiment import load_plan
     from articula.runs.runner import run_to_folder
 
@@ -39,16 +46,25 @@ def plan(
             load_plan(scene_file), out_dir, str(scene_file), force,
             progress=lambda done, total: bar.update(task, completed=done, total=total),
         )  # fmt: skip
+    m = record["metrics"]
     if as_json:
         emit_json(record)
-        return
-    m = record["metrics"]
-    clearance = "no obstacles" if m["min_clearance"] is None else (
-        f"min clearance {m['min_clearance']:.4f} m; collisions {int(m['collisions'])}"
-    )  # fmt: skip
-    out.print(f"RMS error after {m['settle_s']:g} s: {1e3 * m['rms_error']:.3f} mm, max "
-              f"{1e3 * m['max_error']:.3f} mm; {clearance}; {m['time_per_iteration_us']:.1f} "
-              f"µs per iteration; written to {out_dir}")  # fmt: skip
+    else:
+        clearance = "no obstacles" if m["min_clearance"] is None else (
+            f"min clearance {m['min_clearance']:.4f} m; collisions {int(m['collisions'])}"
+        )  # fmt: skip
+        speed = f"{m['time_per_iteration_us']:.1f} µs per iteration"
+        error = f"{1e3 * m['rms_error']:.3f} mm, max {1e3 * m['max_error']:.3f} mm"
+        out.print(f"RMS error after {m['settle_s']:g} s: {error}; {clearance}; {speed}; "
+                  f"written to {out_dir}")  # fmt: skip
+    if m["collisions"] and not allow_collisions:
+        from articula.errors import CollisionError
+
+        raise CollisionError(
+            f"the motion collides in {int(m['collisions'])} steps (deepest "
+            f"{-1e3 * m['min_clearance']:.1f} mm); the run folder {out_dir} is written; pass "
+            "--allow-collisions to accept it, or raise planner.d_min or lambda_weight"
+        )
 
 
 @scene_app.command("check")

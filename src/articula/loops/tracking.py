@@ -27,6 +27,7 @@ class PlanResult:
     error: np.ndarray
     clearance: np.ndarray
     planner_seconds: float  # time spent in planner.step alone [s], not in the recording
+    q0: np.ndarray | None = None  # the start [rad]; None: the first step's speed is unknown
 
 
 def track(
@@ -55,6 +56,7 @@ def track(
         )
     scene, robot = planner.scene, planner.scene.robot
     q = robot.check_q(q0, "q0").copy()
+    q_start = q.copy()
     if np.any(q < robot.lower) or np.any(q > robot.upper):
         raise InfeasibleError("the start breaks the joint limits (Eq. 1.9)", "q0")
     if scene.obstacles:
@@ -87,7 +89,7 @@ def track(
         if scene.obstacles:
             clearance[n] = scene.min_distance(q, tn)
     error = np.linalg.norm(x - x_ref, axis=1)
-    return PlanResult(t, qs, x, x_ref, error, clearance, planner_seconds)
+    return PlanResult(t, qs, x, x_ref, error, clearance, planner_seconds, q_start)
 
 
 def tracking_metrics(
@@ -111,10 +113,22 @@ def tracking_metrics(
         "collisions": float(np.sum(run.clearance <= 0.0)),
         "collisions_settled": float(np.sum(run.clearance[settled] <= 0.0)),
         "joint_limit_violations": float(np.sum(np.any(outside, axis=1))),
+        "max_speed_ratio": max_speed_ratio(run, robot),
         # The planner alone: BAORNN's inner iterations, or a baseline's periods.
         "time_per_iteration_us": 1e6 * run.planner_seconds / max(iterations, 1.0),
         "time_per_period_us": 1e6 * run.planner_seconds / len(run.t),
     }
+
+
+def max_speed_ratio(run: PlanResult, robot: RobotModel) -> float:
+    """The largest |q̇_i| / (URDF speed limit of joint i) over the run, q̇ by finite
+    differences of the periods (from q0 when known); joints without a limit do not count."""
+    q = run.q if run.q0 is None else np.vstack([run.q0, run.q])
+    if len(q) < 2 or len(run.t) < 2:
+        return 0.0
+    speed = np.abs(np.diff(q, axis=0)) / (run.t[1] - run.t[0])
+    limit = np.where(robot.velocity_limit > 0, robot.velocity_limit, np.inf)
+    return float(np.max(speed / limit))
 
 
 def trace_columns(run: PlanResult) -> dict[str, np.ndarray]:

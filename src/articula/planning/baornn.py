@@ -10,7 +10,8 @@ import numpy as np
 from pydantic import Field
 
 from articula.planning import baornn_kernel as kernel
-from articula.planning.objective import Objective
+from articula.planning.objective import Box, Objective
+from articula.planning.rate_limits import RateLimits
 from articula.scene.scene import Scene
 from articula.validation import Positive, StrictModel
 
@@ -37,8 +38,22 @@ class BeetleSearch:
     objective: Objective
     params: BaornnParams
     rng: np.random.Generator
+    rate: RateLimits | None = None  # joint speed (and acceleration) limits; None: the book's
     evaluations: int = field(default=0, init=False)
     iterations: int = field(default=0, init=False)
+    _box: Box | None = field(default=None, init=False, repr=False)  # this period's reach
+
+    def _begin_period(self, q: np.ndarray) -> None:
+        """Narrow the search of this period to what the joint speed limits let it reach."""
+        if self.rate is not None:
+            robot = self.objective.scene.robot
+            self._box = self.rate.box(q, robot.lower, robot.upper)
+
+    def _end_period(self, start: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """Remember the period's motion for the acceleration limit; returns q."""
+        if self.rate is not None:
+            self.rate.record(q - start)
+        return q
 
     @property
     def scene(self) -> Scene:
@@ -64,15 +79,15 @@ class Baornn(BeetleSearch):
             self.evaluations += 3
             self.iterations += 1
             return kernel.iterations(q, g, x_ref, b[None, :], self.params.c1, self.params.c2,
-                                     *obj.kernel_arguments())  # fmt: skip
+                                     *obj.kernel_arguments(self._box))  # fmt: skip
         b /= math.sqrt(b @ b)  # a normalised random direction
         lam = self.params.c1 * np.sqrt(g) if np.isfinite(g) else self.params.c1  # Eq. (1.23)
         # Eqs. (1.15)-(1.18): antennae, projected onto Ω, evaluated by "virtual robots".
-        _, g_left = obj.project_and_value(q + lam * b, q, g, x_ref, t)
-        _, g_right = obj.project_and_value(q - lam * b, q, g, x_ref, t)
+        _, g_left = obj.project_and_value(q + lam * b, q, g, x_ref, t, self._box)
+        _, g_right = obj.project_and_value(q - lam * b, q, g, x_ref, t, self._box)
         delta = self.params.c2 * lam  # Eq. (1.24)
         step = q - delta * np.sign(g_left - g_right) * b  # Eq. (1.19)
-        q_new, g_new = obj.project_and_value(step, q, g, x_ref, t)  # Eq. (1.20)
+        q_new, g_new = obj.project_and_value(step, q, g, x_ref, t, self._box)  # Eq. (1.20)
         self.evaluations += 3
         self.iterations += 1
         if g_new < g:  # Eqs. (1.21)-(1.22): accept only an improvement
@@ -81,7 +96,8 @@ class Baornn(BeetleSearch):
 
     def step(self, q: np.ndarray, x_ref: np.ndarray, t: float) -> np.ndarray:
         """One control period: re-evaluate g for the new reference, then iterate."""
-        obj, k = self.objective, self.params.iterations_per_step
+        obj, k, start = self.objective, self.params.iterations_per_step, q
+        self._begin_period(q)
         g = obj.value(q, x_ref, t)
         if obj.compiled is not None:
             # The same draws as k calls of iterate: the Generator fills rows in order.
@@ -89,8 +105,8 @@ class Baornn(BeetleSearch):
             self.evaluations += 3 * k
             self.iterations += k
             q, _ = kernel.iterations(q, g, x_ref, directions, self.params.c1, self.params.c2,
-                                     *obj.kernel_arguments())  # fmt: skip
-            return q
+                                     *obj.kernel_arguments(self._box))  # fmt: skip
+            return self._end_period(start, q)
         for _ in range(k):
             q, g = self.iterate(q, g, x_ref, t)
-        return q
+        return self._end_period(start, q)

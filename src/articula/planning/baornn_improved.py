@@ -51,8 +51,8 @@ class ImprovedBaornn(BeetleSearch):
         gradient = np.zeros(q.size)
         best_q, best_g = q, g
         for b in directions.T:
-            q_left, g_left = obj.project_and_value(q + lam * b, q, g, x_ref, t)  # Eq. (1.15)
-            q_right, g_right = obj.project_and_value(q - lam * b, q, g, x_ref, t)
+            q_left, g_left = obj.project_and_value(q + lam * b, q, g, x_ref, t, self._box)  # (1.15)
+            q_right, g_right = obj.project_and_value(q - lam * b, q, g, x_ref, t, self._box)
             if np.isfinite(g_left) and np.isfinite(g_right):
                 gradient += (g_left - g_right) * b
             for q_a, g_a in ((q_left, g_left), (q_right, g_right)):
@@ -62,7 +62,7 @@ class ImprovedBaornn(BeetleSearch):
         self.evaluations += 2 * directions.shape[1]
         if norm > 0:
             step = q - p.c2 * lam * gradient / norm  # Eq. (1.19) along the estimated gradient
-            q_new, g_new = obj.project_and_value(step, q, g, x_ref, t)
+            q_new, g_new = obj.project_and_value(step, q, g, x_ref, t, self._box)
             self.evaluations += 1
             if g_new < best_g:  # Eqs. (1.21)-(1.22): only an improvement is accepted
                 best_q, best_g = q_new, g_new
@@ -72,9 +72,11 @@ class ImprovedBaornn(BeetleSearch):
     def step(self, q: np.ndarray, x_ref: np.ndarray, t: float) -> np.ndarray:
         """One control period: warm start, then iterate."""
         start = q
+        self._begin_period(q)
         g = self.objective.value(q, x_ref, t)
         if self._last_motion is not None:
-            q_warm, g_warm = self.objective.project_and_value(q + self._last_motion, q, g, x_ref, t)
+            warm = q + self._last_motion
+            q_warm, g_warm = self.objective.project_and_value(warm, q, g, x_ref, t, self._box)
             self.evaluations += 1
             if g_warm < g:
                 q, g = q_warm, g_warm
@@ -87,7 +89,7 @@ class ImprovedBaornn(BeetleSearch):
             for _ in range(p.iterations_per_step):
                 q, g = self.iterate(q, g, x_ref, t)
         self._last_motion = q - start
-        return q
+        return self._end_period(start, q)
 
     def _compiled(
         self, q: np.ndarray, g: float, x_ref: np.ndarray, draws: np.ndarray
@@ -95,7 +97,7 @@ class ImprovedBaornn(BeetleSearch):
         """The iterations of `draws` by planning/baornn_kernel.py."""
         obj, p = self.objective, self.params
         (lambda_weight, beta, d_min, use_distance, lower, upper, arrays,
-         static_min) = obj.kernel_arguments()  # fmt: skip
+         static_min) = obj.kernel_arguments(self._box)  # fmt: skip
         q, g, evaluations = kernel.improved_iterations(
             q, g, x_ref, draws, p.c1, p.c2, lambda_weight, beta, d_min, use_distance, lower,
             upper, arrays, obj.kinematics_arguments(), static_min,

@@ -14,8 +14,10 @@ from articula.planning.baornn_improved import ImprovedBaornn, ImprovedParams
 from articula.planning.objective import Objective
 from articula.planning.planner import Planner
 from articula.planning.qp_ik import QpIk, QpIkParams
+from articula.planning.rate_limits import RateLimits
 from articula.planning.trajectories import Circle, Waypoints, rectangle
 from articula.planning.velocity_ik import VelocityIk, VelocityIkParams
+from articula.robots.model import RobotModel
 from articula.scene.config import resolve_path
 from articula.scene.scene import Scene
 from articula.validation import (
@@ -89,6 +91,11 @@ class PlannerSpec(StrictModel):
     safety: NonNegative = 0.03
     seed: Seed | None = None
     max_steps: Annotated[int, Field(ge=1, le=10**9)] = MAX_STEPS  # refuse longer runs
+    # Joint speed limits: the URDF's, scaled; "none" lets BAORNN move as fast as the book's
+    # Algorithm 1 does (the baselines' solvers always keep them).
+    limits: Literal["velocity", "none"] = "velocity"
+    velocity_scale: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 1.0
+    max_acceleration: Positive | None = None  # [rad/s²] for every joint; None: no limit
 
     @model_validator(mode="after")
     def _times(self) -> PlannerSpec:
@@ -121,19 +128,32 @@ def _planner(spec: PlannerSpec, scene: Scene, seed: int) -> Planner:
     """make_planner without the renaming of its errors."""
     rng = np.random.default_rng(seed)
     objective = Objective(scene, spec.lambda_weight, spec.beta, spec.d_min)
+    rate = rate_limits(spec, scene.robot)
     if spec.method == "baornn":
         params = BaornnParams(c1=spec.c1, c2=spec.c2, iterations_per_step=spec.iterations_per_step)
-        return Baornn(objective, params, rng)
+        return Baornn(objective, params, rng, rate)
     if spec.method == "baornn-improved":
         improved = ImprovedParams(c1=spec.c1, c2=spec.c2, pairs=spec.pairs,
                                   iterations_per_step=spec.iterations_per_step)  # fmt: skip
-        return ImprovedBaornn(objective, improved, rng)
+        return ImprovedBaornn(objective, improved, rng, rate)
     if spec.method == "qp":
-        qp = QpIkParams(gain=spec.gain, influence=spec.influence, safety=spec.safety)
+        qp = QpIkParams(gain=spec.gain, influence=spec.influence, safety=spec.safety,
+                        speed_scale=spec.velocity_scale)  # fmt: skip
         return QpIk(scene, spec.dt, qp, spec.d_min)
-    velocity = VelocityIkParams(gain=spec.gain, damping=spec.damping, repulsion=spec.repulsion,
-                                influence=spec.influence)  # fmt: skip
+    velocity = VelocityIkParams(
+        gain=spec.gain, damping=spec.damping, repulsion=spec.repulsion, influence=spec.influence,
+        speed_scale=spec.velocity_scale,
+    )  # fmt: skip
     return VelocityIk(scene, spec.method, spec.dt, velocity, spec.d_min)
+
+
+def rate_limits(spec: PlannerSpec, robot: RobotModel) -> RateLimits | None:
+    """The joint speed limits of `robot` (its URDF's, times velocity_scale; a joint without
+    one has none) and the acceleration limit a PlannerSpec asks for, or None for "none"."""
+    if spec.limits == "none":
+        return None
+    speeds = np.where(robot.velocity_limit > 0, robot.velocity_limit, np.inf)
+    return RateLimits(spec.velocity_scale * speeds, spec.dt, spec.max_acceleration)
 
 
 # "QpIkParams.safety" -> "planner.safety": the library's names of the [planner] keys.

@@ -12,6 +12,8 @@ from articula.errors import ConfigError, ModelError
 from articula.scene.compiled_clearance import CompiledClearance
 from articula.scene.scene import Scene
 
+Box = tuple[np.ndarray, np.ndarray]  # (lower, upper) of the configurations allowed [rad]
+
 
 @dataclass(frozen=True)
 class Objective:
@@ -40,16 +42,17 @@ class Objective:
         if self.use_compiled:
             object.__setattr__(self, "compiled", CompiledClearance.build(self.scene))
 
-    def kernel_arguments(self) -> tuple:
-        """Λ, β, d_min, whether distances count, joint limits and the compiled scene arrays,
-        in the order of planning.baornn_kernel (requires `compiled`)."""
+    def kernel_arguments(self, box: Box | None = None) -> tuple:
+        """Λ, β, d_min, whether distances count, the projection box (default: the joint
+        limits) and the compiled scene arrays, in the order of planning.baornn_kernel
+        (requires `compiled`)."""
         robot, c = self.scene.robot, self.compiled
         if c is None:
             raise ModelError("this scene has no compiled evaluation (see Objective.compiled)")
         pairs = None if self.needs_distance else c.no_pairs  # Λ = d_min = 0: no GJK at all
-        return (self.lambda_weight, self.beta, self.d_min, self.needs_distance,
-                robot.model.lowerPositionLimit, robot.model.upperPositionLimit, c.arrays(pairs),
-                c.static_min)  # fmt: skip
+        lower, upper = box or (robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
+        return (self.lambda_weight, self.beta, self.d_min, self.needs_distance, lower, upper,
+                c.arrays(pairs), c.static_min)  # fmt: skip
 
     @property
     def needs_distance(self) -> bool:
@@ -81,12 +84,19 @@ class Objective:
         return math.sqrt(e @ e)
 
     def project_and_value(
-        self, q: np.ndarray, q_current: np.ndarray, g_current: float, x_ref: np.ndarray, t: float
+        self,
+        q: np.ndarray,
+        q_current: np.ndarray,
+        g_current: float,
+        x_ref: np.ndarray,
+        t: float,
+        box: Box | None = None,
     ) -> tuple[np.ndarray, float]:
-        """(P_Ω(q), g there), Eqs. (1.17)-(1.18): clip to the joint limits (1.9); if the clipped
-        point is closer than d_min to an obstacle, stay at (q_current, g_current). One distance
-        query serves both the constraint and the penalty."""
-        clipped = self.scene.robot.clip(q)
+        """(P_Ω(q), g there), Eqs. (1.17)-(1.18): clip to the joint limits (1.9), or to `box`
+        (the joint limits narrowed by speed limits); if the clipped point is closer than d_min
+        to an obstacle, stay at (q_current, g_current). One distance query serves both the
+        constraint and the penalty."""
+        clipped = self.scene.robot.clip(q) if box is None else np.clip(q, *box)
         if self.compiled is not None:
             d, ee = self.compiled.evaluate(clipped, self.needs_distance)
             if self.needs_distance and d <= self.d_min:  # Ω: d > d_min (1.12); 0 on overlap

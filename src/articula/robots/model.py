@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -16,6 +16,12 @@ from articula.geometry.shapes import ConvexShape
 from articula.limits import MAX_ANGLE, MAX_LENGTH, MAX_LINKS
 from articula.native import captured_output
 from articula.robots.urdf_geometry import collision_shapes
+
+# Limits [rad] given to a continuous joint, read as a revolute one so that it keeps one
+# configuration entry (Pinocchio's unbounded joints use two, cos and sin). ±2π lets the joint
+# reach every orientation from either side and turn a full circle each way from 0, while BAORNN's
+# samples within the limits stay meaningful (±MAX_ANGLE would spread them over 300 turns).
+CONTINUOUS_LIMIT = 2 * np.pi
 
 BUILTIN = {"iiwa14": ("iiwa14/iiwa14.urdf", "iiwa_link_ee")}
 
@@ -31,7 +37,11 @@ class LinkGeometry:
 
 
 class RobotModel:
-    """A serial arm of 1-DoF revolute or prismatic joints, loaded from a URDF."""
+    """A serial arm of 1-DoF revolute or prismatic joints, loaded from a URDF.
+
+    Mimic joints (URDF <mimic>) have no configuration entry of their own: they follow the
+    joint they mimic, q_mimic = multiplier · q_joint + offset, in every kinematic quantity.
+    """
 
     def __init__(self, model: pin.Model, links: Sequence[LinkGeometry], ee_frame: str) -> None:
         if not model.existFrame(ee_frame):
@@ -50,30 +60,44 @@ class RobotModel:
         package_dirs: Sequence[str | Path] = (),
         ee_frame: str | None = None,
         max_links: int = MAX_LINKS,
+        locked_joints: Mapping[str, float] | None = None,
+        ee_offset: np.ndarray | None = None,
     ) -> RobotModel:
         """Load kinematics and collision shapes.
+
+        Continuous joints become revolute joints within ±CONTINUOUS_LIMIT [rad]; mimic joints
+        follow the joint they mimic.
 
         Args:
             path: the URDF file.
             package_dirs: folders that hold the packages its package:// meshes name.
             ee_frame: the end-effector frame; default the last link.
             max_links: refuse a URDF with more links (checked before anything is built).
+            locked_joints: joint name -> fixed value [rad or m]; these joints leave the model
+                (a reduced model: nq drops by one each) and their links stay where the value
+                puts them. Mimic joints of a locked joint are locked with it.
+            ee_offset: pose (4×4) of the tool point in the `ee_frame` frame [m]; the tool
+                point becomes a new frame, named `<ee_frame>_offset`, and the end effector.
         """
         urdf = Path(path)
         if not urdf.is_file():
             raise ConfigError("urdf", f"{urdf}: file not found")
         _check_size(urdf, max_links)
+        xml, continuous, mimics = _prepare_urdf(urdf)
         failure: Exception | None = None
         with captured_output() as printed:  # the parser prints its errors past sys.stdout
             try:
-                model = pin.buildModelFromUrdf(str(urdf))
+                model = pin.buildModelFromXML(xml, mimic=True)
             except (RuntimeError, ValueError) as exc:
                 failure = exc
         if failure is not None:
             said = f"; the parser said: {' '.join(printed[:2])}" if printed else ""
             raise ModelError(f"{urdf}: Pinocchio cannot build the model ({failure}){said}")
+        _unbounded(model, continuous)
         _check_serial(model, urdf)
         _check_magnitudes(model, urdf)
+        if locked_joints:
+            model = _lock(model, dict(locked_joints), mimics)
         shapes = collision_shapes(urdf, [Path(d) for d in package_dirs])
         links = []
         for name, items in shapes.items():
@@ -86,17 +110,36 @@ class RobotModel:
         links.sort(key=lambda link: link.frame_id)
         if ee_frame is None:
             ee_frame = [f.name for f in model.frames if f.type == pin.FrameType.BODY][-1]
+        if ee_offset is not None:
+            ee_frame = _add_tool_frame(model, ee_frame, ee_offset)
         return cls(model, links, ee_frame)
 
     @classmethod
-    def builtin(cls, name: str, ee_frame: str | None = None) -> RobotModel:
-        """A robot shipped with articula: "iiwa14" (KUKA LBR iiwa 14 R820); `ee_frame`
-        overrides its end-effector frame."""
+    def builtin(
+        cls,
+        name: str,
+        ee_frame: str | None = None,
+        locked_joints: Mapping[str, float] | None = None,
+        ee_offset: np.ndarray | None = None,
+    ) -> RobotModel:
+        """A robot shipped with articula.
+
+        Args:
+            name: "iiwa14" (KUKA LBR iiwa 14 R820).
+            ee_frame: overrides its end-effector frame.
+            locked_joints: joint name -> fixed value [rad or m] (see `from_urdf`).
+            ee_offset: pose (4×4) of the tool point in the end-effector frame [m].
+        """
         if name not in BUILTIN:
             raise ConfigError("builtin", f"unknown robot {name!r}; choose one of {sorted(BUILTIN)}")
         relative, default_frame = BUILTIN[name]
         with resources.as_file(resources.files("articula.robots") / "data" / relative) as urdf:
-            return cls.from_urdf(urdf, ee_frame=ee_frame or default_frame)
+            return cls.from_urdf(
+                urdf,
+                ee_frame=ee_frame or default_frame,
+                locked_joints=locked_joints,
+                ee_offset=ee_offset,
+            )
 
     @property
     def nq(self) -> int:
@@ -105,8 +148,12 @@ class RobotModel:
 
     @property
     def joint_names(self) -> list[str]:
-        """Names of the actuated joints, base to tip."""
-        return list(self.model.names)[1:]
+        """Names of the joints with a configuration entry, base to tip (no mimic joints)."""
+        return [
+            name
+            for name, joint in zip(self.model.names[1:], self.model.joints[1:], strict=True)
+            if joint.nq == 1
+        ]
 
     @property
     def lower(self) -> np.ndarray:
@@ -224,10 +271,111 @@ def _check_magnitudes(model: pin.Model, urdf: Path) -> None:
 
 
 def _check_serial(model: pin.Model, urdf: Path) -> None:
-    """Only 1-DoF joints (revolute, prismatic) are supported, one per configuration entry."""
+    """Only 1-DoF joints (revolute, prismatic) are supported, one per configuration entry, and
+    mimic joints that follow one of them."""
     for joint, name in zip(model.joints[1:], model.names[1:], strict=True):
+        if joint.shortname() == "JointModelMimic":
+            continue
         if joint.nq != 1 or joint.nv != 1:
             raise ModelError(
-                f"{urdf}: joint {name!r} ({joint.shortname()}) is not a 1-DoF revolute or "
-                "prismatic joint; continuous joints need finite limits (type revolute)"
+                f"{urdf}: joint {name!r} ({joint.shortname()}) is not a 1-DoF revolute, "
+                "continuous or prismatic joint"
             )
+
+
+def _prepare_urdf(urdf: Path) -> tuple[str, list[tuple[str, str]], dict[str, str]]:
+    """(URDF text with every continuous joint made revolute within ±CONTINUOUS_LIMIT, the
+    (joint, "velocity" | "effort") limits it lacked, mimic joint -> the joint it follows)."""
+    try:
+        root = ET.parse(urdf).getroot()
+    except (ET.ParseError, OSError) as exc:
+        raise ModelError(f"{urdf}: cannot read URDF ({exc})") from None
+    unlimited = []
+    mimics = {}
+    for joint in root.iter("joint"):
+        mimic = joint.find("mimic")
+        if mimic is not None:
+            mimics[joint.get("name", "")] = mimic.get("joint", "")
+        if joint.get("type") != "continuous":
+            continue
+        joint.set("type", "revolute")
+        limit = joint.find("limit")
+        if limit is None:
+            limit = ET.SubElement(joint, "limit")
+        limit.set("lower", repr(-CONTINUOUS_LIMIT))
+        limit.set("upper", repr(CONTINUOUS_LIMIT))
+        for key in ("velocity", "effort"):
+            if limit.get(key) is None:
+                # urdfdom needs both for a revolute joint; _unbounded restores a missing one
+                # as ∞, what Pinocchio gives a continuous joint without it.
+                unlimited.append((joint.get("name", ""), key))
+                limit.set(key, "0")
+    return ET.tostring(root, encoding="unicode"), unlimited, mimics
+
+
+def _unbounded(model: pin.Model, missing: Sequence[tuple[str, str]]) -> None:
+    """Set the named (joint, "velocity" | "effort") limits to ∞ (the URDF gave none)."""
+    limits = {"velocity": model.velocityLimit.copy(), "effort": model.effortLimit.copy()}
+    for name, key in missing:
+        limits[key][model.joints[model.getJointId(name)].idx_v] = np.inf
+    model.velocityLimit, model.effortLimit = limits["velocity"], limits["effort"]
+
+
+def _lock(model: pin.Model, values: dict[str, float], mimics: Mapping[str, str]) -> pin.Model:
+    """The reduced model with the named joints fixed at their values [rad or m]; the other
+    joints' reference is neutral (it does not matter: their frames keep their placements)."""
+    q_reference = pin.neutral(model)
+    ids = []
+    for name, value in values.items():
+        field = f"locked_joints.{name}"
+        if not model.existJointName(name):
+            free = [n for n, j in zip(model.names[1:], model.joints[1:], strict=True) if j.nq]
+            raise ConfigError(field, f"no joint {name!r}; the joints are {free}")
+        if name in mimics:
+            raise ConfigError(
+                field, f"{name!r} mimics {mimics[name]!r}; lock {mimics[name]!r} instead"
+            )
+        joint_id = model.getJointId(name)
+        index = model.joints[joint_id].idx_q
+        low, high = model.lowerPositionLimit[index], model.upperPositionLimit[index]
+        if not low <= value <= high:
+            raise ConfigError(field, f"{value!r} is outside the joint's limits [{low:g}, {high:g}]")
+        q_reference[index] = value
+        ids.append(joint_id)
+        # A mimic joint of a locked joint is locked with it, at the value it follows.
+        ids += [model.getJointId(m) for m, followed in mimics.items() if followed == name]
+    if len(ids) - sum(1 for j in ids if model.joints[j].nq == 0) >= model.nq:
+        raise ConfigError("locked_joints", "locks every joint; leave at least one free")
+    return pin.buildReducedModel(model, sorted(set(ids)), q_reference)
+
+
+def _add_tool_frame(model: pin.Model, ee_frame: str, offset: np.ndarray) -> str:
+    """Add the frame at pose `offset` (4×4, [m]) in frame `ee_frame` and return its name."""
+    T = np.asarray(offset, dtype=float)
+    if T.shape != (4, 4):
+        raise ConfigError("ee_offset", f"needs a 4×4 pose (got shape {T.shape})")
+    R, p = T[:3, :3], T[:3, 3]
+    if not (
+        np.all(np.abs(p) <= MAX_LENGTH)
+        and np.allclose(R @ R.T, np.eye(3), atol=1e-9)
+        and np.linalg.det(R) > 0
+        and np.array_equal(T[3], [0.0, 0.0, 0.0, 1.0])
+    ):
+        raise ConfigError(
+            "ee_offset",
+            f"needs a rigid pose: a rotation and a translation within ±{MAX_LENGTH:g} m "
+            f"(got {T.tolist()})",
+        )
+    if not model.existFrame(ee_frame):
+        names = [f.name for f in model.frames if f.type == pin.FrameType.BODY]
+        raise ConfigError("ee_frame", f"no frame {ee_frame!r}; the links are {names}")
+    name = f"{ee_frame}_offset"
+    if model.existFrame(name):
+        raise ConfigError("ee_offset", f"the URDF already has a frame {name!r}")
+    parent_id = model.getFrameId(ee_frame)
+    parent = model.frames[parent_id]
+    placement = parent.placement * pin.SE3(R.copy(), p.copy())
+    model.addFrame(
+        pin.Frame(name, parent.parentJoint, parent_id, placement, pin.FrameType.OP_FRAME)
+    )
+    return name

@@ -34,13 +34,23 @@ SHAPE_KEYS = ("mesh", "box", "sphere", "cylinder", "capsule")
 PACKAGE_URI = "package://articula/"  # a file shipped inside articula
 
 
+class EeOffsetSpec(StrictModel):
+    """[robot] ee_offset: the tool point's pose in the ee_frame, xyz [m] and rpy [rad]."""
+
+    xyz: Point = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+    rpy: Rpy = Field(default_factory=lambda: [0.0, 0.0, 0.0])
+
+
 class RobotSpec(StrictModel):
-    """[robot]: a built-in robot or a URDF, and its initial configuration q0 [rad]."""
+    """[robot]: a built-in robot or a URDF, and its initial configuration q0 [rad]; joints to
+    lock at fixed values [rad or m] and the tool point's offset from ee_frame."""
 
     builtin: str | None = None
     urdf: str | None = None
     package_dirs: list[str] = Field(default_factory=list)
     ee_frame: str | None = None
+    ee_offset: EeOffsetSpec | None = None
+    locked_joints: dict[str, Radians] = Field(default_factory=dict)  # joint -> [rad or m]
     q0: list[Radians] | None = None
     max_links: Annotated[int, Field(ge=1, le=100_000)] = MAX_LINKS  # refuse larger URDFs
 
@@ -97,15 +107,20 @@ def build_scene(
 ) -> tuple[Scene, np.ndarray]:
     """The Scene and its initial configuration q0; relative paths start at `base_dir`."""
     r = spec.robot
-    with fields_as({name: f"robot.{name}" for name in RobotSpec.model_fields}):
+    fields = {name: f"robot.{name}" for name in RobotSpec.model_fields}
+    fields |= {f"locked_joints.{name}": f"robot.locked_joints.{name}" for name in r.locked_joints}
+    offset = None if r.ee_offset is None else pose(r.ee_offset.xyz, r.ee_offset.rpy)
+    with fields_as(fields):
         if r.builtin is not None:
-            robot = RobotModel.builtin(r.builtin, r.ee_frame)
+            robot = RobotModel.builtin(r.builtin, r.ee_frame, r.locked_joints, offset)
         else:
             robot = RobotModel.from_urdf(
                 resolve_path(base_dir, r.urdf or ""),
                 [resolve_path(base_dir, d) for d in r.package_dirs],
                 r.ee_frame,
                 r.max_links,
+                r.locked_joints,
+                offset,
             )
     q0 = robot.check_q(r.q0 if r.q0 is not None else np.zeros(robot.nq), "robot.q0")
     obstacles = []

@@ -77,7 +77,8 @@ def _comparison_lines(table: Table, full: bool, p: Mapping[str, Any]) -> list[st
         f"control (K = {p['gain']:g}/s) with a null-space FIRAS repulsion (η = "
         f"{p['repulsion']:g}, influence {p['influence']:g} m); qp: NEO-style velocity dampers "
         f"(influence {p['influence']:g} m, safety {p['safety']:g} m) solved by daqp. The "
-        "baselines are limited to the URDF joint speeds; BAORNN, as in the book, is not. "
+        "baselines are limited to the URDF joint speeds; BAORNN, as in the book, is not "
+        '(`limits = "none"`; `articula plan` applies the speed limits by default). '
         "Times are of the planner alone (not the recording): per period (one control step) "
         "and per iteration (BAORNN's inner iterations; a baseline's iteration is its period).",
         "",

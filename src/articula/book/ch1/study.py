@@ -75,7 +75,8 @@ def plan_config(run: Run) -> dict[str, Any]:
     Its meshes are named inside the package (package://articula/...), so that the config, its
     hash and its run folder are the same on every machine and install; a seed override goes
     to the top of the config; the tolerance is lifted so that every result is reported,
-    however large its error, instead of refused.
+    however large its error, instead of refused; BAORNN runs without joint speed limits, as
+    the book's does (the baselines' solvers keep them).
     """
     data = {"experiment": NAME, **load_toml(scene_path(run.scene))}
     for obstacle in data.get("obstacles", []):
@@ -84,7 +85,8 @@ def plan_config(run: Run) -> dict[str, Any]:
     overrides = dict(run.overrides)
     if "seed" in overrides:
         data["seed"] = overrides.pop("seed")
-    data["planner"] = {**data["planner"], **overrides, "tolerance": 1e3}
+    # The book's Algorithm 1 has no joint speed limits: its runs keep none (limits = "none").
+    data["planner"] = {**data["planner"], **overrides, "tolerance": 1e3, "limits": "none"}
     return data
 
 
