@@ -268,3 +268,31 @@ def test_scene_check_reports_joint_limits(cli):
     q = "0,0,0,0,0,0,3.1"
     outside = json.loads(cli("scene", "check", TWO_OBSTACLES, "--q", q, "--json").stdout)
     assert outside["within_limits"] is False  # joint 7 is limited to ±175° = ±3.054 rad
+
+
+def test_many_configurations_from_a_csv_or_parquet_file_give_one_row_each(cli, one_json, tmp_path):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    rows = [[0.0] * 7, [0.0, 0.5, 0.0, -1.0, 0.0, 0.6, 0.0]]
+    csv = tmp_path / "q.csv"
+    csv.write_text("q_1,q_2,q_3,q_4,q_5,q_6,q_7\n" + "\n".join(",".join(map(str, r)) for r in rows))
+    parquet = tmp_path / "q.parquet"
+    pq.write_table(pa.table({f"q_{j + 1}": [r[j] for r in rows] for j in range(7)}), parquet)
+    singles = [one_json(cli("scene", "check", TWO_OBSTACLES, "--q", ",".join(map(str, r)),
+                            "--json").stdout) for r in rows]  # fmt: skip
+    for path in (csv, parquet):
+        proc = cli("scene", "check", TWO_OBSTACLES, "--q-file", path, "--json")
+        assert proc.returncode == 0, proc.stderr
+        assert one_json(proc.stdout)["configurations"] == singles
+
+
+@pytest.mark.parametrize(
+    ("content", "words"),
+    [("1,2,3\n", ("--q-file", "7 joint values")), ("a,b\nx,y\n", ("--q-file", "numbers"))],
+)
+def test_a_bad_q_file_is_one_line_naming_the_option(main_fails, tmp_path, content, words):
+    path = tmp_path / "q.csv"
+    path.write_text(content)
+    line = main_fails("scene", "check", TWO_OBSTACLES, "--q-file", path, "--json")
+    assert all(w in line for w in words), line

@@ -59,11 +59,13 @@ def _finite(obj: Any) -> Any:
 
 def print_table(title: str, columns: tuple[str, str], rows: list[tuple[str, str]]) -> None:
     """A two-column table on stdout, values right-aligned."""
-    table = Table(title=title)
-    table.add_column(columns[0])
-    table.add_column(columns[1], justify="right")
+    from rich.markup import escape  # "[m]" is a unit, not rich markup
+
+    table = Table(title=escape(title))
+    table.add_column(escape(columns[0]))
+    table.add_column(escape(columns[1]), justify="right")
     for row in rows:
-        table.add_row(*row)
+        table.add_row(*(escape(cell) for cell in row))
     out.print(table)
 
 

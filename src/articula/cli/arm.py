@@ -78,14 +78,24 @@ def scene_check(
     metric: Annotated[
         str, typer.Option(help="gjk (signed convex distance) or vertex (book).")
     ] = "gjk",
+    q_file: Annotated[
+        Path | None,
+        typer.Option("--q-file", help="CSV or Parquet: one configuration per row [rad]."),
+    ] = None,
     as_json: JsonFlag = False,
 ) -> None:
-    """End-effector position and link-obstacle clearances of a scene at q0 or --q."""
+    """End-effector position and link-obstacle clearances of a scene at q0, --q or each row of
+    --q-file."""
     from articula.scene.check import check_scene
 
-    result = check_scene(scene_file, q, metric)
+    result = check_scene(scene_file, q, metric, q_file)
     if as_json:
         emit_json(result)
+        return
+    if q_file is not None:
+        rows = [(str(i), f"{r['min_clearance']:.4f}{' collides' if r['collides'] else ''}")
+                for i, r in enumerate(result["configurations"])]  # fmt: skip
+        print_table(f"{scene_file} ({metric} metric)", ("row", "min clearance [m]"), rows)
         return
     rows = [(name, f"{value:.4f}") for name, value in result["link_clearance"].items()]
     print_table(f"{scene_file} ({metric} metric)", ("link", "clearance [m]"), rows)

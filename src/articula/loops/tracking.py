@@ -8,8 +8,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from articula.errors import ConfigError, InfeasibleError
+from articula.errors import ConfigError
 from articula.limits import MAX_STEPS
+from articula.loops.online import OnlineController
 from articula.planning.planner import Planner
 from articula.robots.model import RobotModel
 
@@ -39,7 +40,8 @@ def track(
     max_steps: int = MAX_STEPS,
     progress: Callable[[int, int], None] | None = None,
 ) -> PlanResult:
-    """Follow `trajectory` from q0 [rad] for `duration` [s], one planner step per `dt` [s].
+    """Follow `trajectory` from q0 [rad] for `duration` [s], one step per `dt` [s] of an
+    OnlineController, the object a live loop uses.
 
     A run of more than `max_steps` periods is refused before anything is allocated;
     `progress(done, total)` is told about every hundredth of the run.
@@ -54,24 +56,12 @@ def track(
             f"{duration:g} s at dt = {dt:g} s is more than max_steps = {max_steps} periods; "
             "shorten it, raise dt or raise max_steps",
         )
+    controller = OnlineController(planner, dt)
+    q_start = controller.reset(q0)
     scene, robot = planner.scene, planner.scene.robot
-    q = robot.check_q(q0, "q0").copy()
-    q_start = q.copy()
-    if np.any(q < robot.lower) or np.any(q > robot.upper):
-        raise InfeasibleError("the start breaks the joint limits (Eq. 1.9)", "q0")
-    if scene.obstacles:
-        d0 = scene.min_distance(q)
-        if d0 <= 0:
-            raise InfeasibleError(f"the start collides with an obstacle (d = {d0:.4f} m)", "q0")
-        if d0 <= planner.d_min:
-            raise InfeasibleError(
-                f"the start is {d0:.4f} m from an obstacle, within d_min = {planner.d_min} m "
-                "(Eq. 1.12); lower d_min or move the start",
-                "q0",
-            )
     steps = round(duration / dt)
     t = np.arange(steps) * dt
-    qs = np.empty((steps, q.size))
+    qs = np.empty((steps, q_start.size))
     x = np.empty((steps, 3))
     x_ref = np.empty((steps, 3))
     clearance = np.full(steps, np.inf)
@@ -82,7 +72,7 @@ def track(
             progress(n, steps)
         x_ref[n] = trajectory(tn)
         start = time.perf_counter()
-        q = planner.step(q, x_ref[n], tn)
+        q = controller.step(x_ref[n])
         planner_seconds += time.perf_counter() - start
         qs[n] = q
         x[n] = robot.ee_position(q)

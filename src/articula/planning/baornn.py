@@ -43,6 +43,11 @@ class BeetleSearch:
     iterations: int = field(default=0, init=False)
     _box: Box | None = field(default=None, init=False, repr=False)  # this period's reach
 
+    def reset(self) -> None:
+        """Forget the previous periods: the arm starts at rest."""
+        if self.rate is not None:
+            self.rate.reset()
+
     def _begin_period(self, q: np.ndarray) -> None:
         """Narrow the search of this period to what the joint speed limits let it reach."""
         if self.rate is not None:

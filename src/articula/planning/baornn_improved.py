@@ -69,6 +69,11 @@ class ImprovedBaornn(BeetleSearch):
         self.iterations += 1
         return best_q, best_g
 
+    def reset(self) -> None:
+        """Forget the previous periods: no warm start, the arm at rest."""
+        super().reset()
+        self._last_motion = None
+
     def step(self, q: np.ndarray, x_ref: np.ndarray, t: float) -> np.ndarray:
         """One control period: warm start, then iterate."""
         start = q

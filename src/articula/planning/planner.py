@@ -30,3 +30,7 @@ class Planner(Protocol):
     def step(self, q: np.ndarray, x_ref: np.ndarray, t: float) -> np.ndarray:
         """The configuration [rad] for time t [s]."""
         ...
+
+    def reset(self) -> None:
+        """Forget the previous periods (their motion, their reference): a new start at rest."""
+        ...

@@ -55,6 +55,10 @@ class QpIk:
     infeasible: int = field(default=0, init=False)
     _previous_ref: np.ndarray | None = field(default=None, init=False)
 
+    def reset(self) -> None:
+        """Forget the previous reference point: the next period has no feed-forward."""
+        self._previous_ref = None
+
     def step(self, q: np.ndarray, x_ref: np.ndarray, t: float) -> np.ndarray:
         """One period: solve for q̇ (stop if the QP has no solution) and integrate for dt."""
         qdot = self._solve(q, x_ref, t)

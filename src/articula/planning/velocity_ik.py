@@ -41,6 +41,10 @@ class VelocityIk:
     iterations: int = field(default=0, init=False)
     _previous_ref: np.ndarray | None = field(default=None, init=False)
 
+    def reset(self) -> None:
+        """Forget the previous reference point: the next period has no feed-forward."""
+        self._previous_ref = None
+
     def step(self, q: np.ndarray, x_ref: np.ndarray, t: float) -> np.ndarray:
         """One period: integrate q̇ for dt and clip to the joint limits."""
         robot, p = self.scene.robot, self.params

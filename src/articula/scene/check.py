@@ -9,7 +9,10 @@ import numpy as np
 
 from articula.errors import ConfigError
 from articula.scene.config import build_scene, load_scene_spec
+from articula.scene.scene import Scene
 from articula.validation import load_toml
+
+MAX_ROWS = 100_000  # configurations of one --q-file
 
 
 def parse_q(text: str) -> np.ndarray:
@@ -20,13 +23,60 @@ def parse_q(text: str) -> np.ndarray:
         raise ConfigError("--q", f"expected comma-separated numbers (got {text!r})") from None
 
 
-def check_scene(path: Path, q_text: str | None = None, metric: str = "gjk") -> dict[str, Any]:
-    """End-effector position, clearances per link and obstacle, and whether anything collides."""
+def read_q_file(path: Path, nq: int, max_rows: int = MAX_ROWS) -> np.ndarray:
+    """Configurations [rad], one per row, from a CSV (a header line is allowed) or Parquet file
+    of `nq` numeric columns."""
+    if not path.is_file():
+        raise ConfigError("--q-file", f"{path}: file not found")
+    try:
+        if path.suffix.lower() == ".parquet":
+            import pyarrow.parquet as pq
+
+            table = pq.read_table(path)
+            rows = np.column_stack([table[c].to_numpy() for c in table.column_names])
+        else:
+            text = path.read_text(encoding="utf-8").splitlines()
+            body = text[1:] if text and not _numeric(text[0]) else text
+            rows = np.array([[float(v) for v in line.split(",")] for line in body if line.strip()])
+    except (ValueError, OSError, ImportError) as exc:
+        raise ConfigError("--q-file", f"{path}: not a table of numbers ({exc})") from None
+    if rows.ndim != 2 or rows.shape[1] != nq or not 0 < len(rows) <= max_rows:
+        raise ConfigError(
+            "--q-file",
+            f"{path}: needs 1 to {max_rows} rows of {nq} joint values (got shape {rows.shape})",
+        )
+    return rows
+
+
+def _numeric(line: str) -> bool:
+    try:
+        [float(v) for v in line.split(",")]
+    except ValueError:
+        return False
+    return True
+
+
+def check_scene(
+    path: Path, q_text: str | None = None, metric: str = "gjk", q_file: Path | None = None
+) -> dict[str, Any]:
+    """End-effector position, clearances per link and obstacle, and whether anything collides,
+    at q0, at --q, or (with --q-file) at every row of a file: {"configurations": [...]}."""
     spec = load_scene_spec(load_toml(path), str(path))
     if metric not in ("gjk", "vertex"):
         raise ConfigError("--metric", f"unknown metric {metric!r}; choose gjk or vertex")
+    if q_text is not None and q_file is not None:
+        raise ConfigError("--q-file", "give --q or --q-file, not both")
     scene, q0 = build_scene(spec, path.parent, metric="vertex" if metric == "vertex" else "gjk")
+    if q_file is not None:
+        rows = read_q_file(q_file, scene.robot.nq)
+        return {"configurations": [_check(scene, scene.robot.check_q(q, "--q-file"), metric)
+                                   for q in rows]}  # fmt: skip
     q = q0 if q_text is None else scene.robot.check_q(parse_q(q_text), "--q")
+    return _check(scene, q, metric)
+
+
+def _check(scene: Scene, q: np.ndarray, metric: str) -> dict[str, Any]:
+    """The summary of one configuration."""
     d = scene.distances(q)
     min_clearance = float(d.min()) if d.size else float("inf")
     return {

@@ -28,7 +28,7 @@ class Obstacle:
         if not self.parts:
             raise GeometryError(f"obstacle {self.name!r}: has no convex parts")
         if not callable(self.pose):
-            _check_pose(self.name, self.pose)
+            check_pose(self.name, self.pose)
 
     @property
     def moving(self) -> bool:
@@ -38,11 +38,12 @@ class Obstacle:
     def pose_at(self, t: float) -> np.ndarray:
         """The obstacle's pose (4×4, world) at time t [s]."""
         if callable(self.pose):
-            return _check_pose(self.name, np.asarray(self.pose(t), dtype=float))
+            return check_pose(self.name, np.asarray(self.pose(t), dtype=float))
         return self.pose
 
 
-def _check_pose(name: str, T: np.ndarray) -> np.ndarray:
+def check_pose(name: str, T: np.ndarray) -> np.ndarray:
+    """T if it is a finite 4×4 pose with a rotation; GeometryError naming obstacle `name`."""
     if T.shape != (4, 4) or not np.all(np.isfinite(T)):
         raise GeometryError(f"obstacle {name!r}: pose must be a finite 4×4 matrix (got {T.shape})")
     R = T[:3, :3]

@@ -1,0 +1,119 @@
+"""The arm's controller for a live loop: one control period per call, obstacles moved per call.
+
+`track` (and so `articula plan`) drives the same object along a reference path, so a live loop
+and a planned run share one code path:
+
+    controller = OnlineController.from_spec(scene, PlannerSpec(method="qp"), live_obstacles=True)
+    q = controller.reset(q_measured)
+    every 10 ms:
+        q = controller.step(target, {"box": pose_from_camera})   # send q to the arm
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from articula.errors import ConfigError, GeometryError, InfeasibleError
+from articula.planning.config import PlannerSpec, make_planner
+from articula.planning.planner import Planner
+from articula.scene.obstacles import Obstacle, check_pose
+from articula.scene.scene import Scene
+
+
+class LivePose:
+    """An obstacle pose a live loop sets each period; as a pose function it ignores time."""
+
+    def __init__(self, pose: np.ndarray) -> None:
+        self.pose = np.array(pose, dtype=float)
+
+    def __call__(self, t: float) -> np.ndarray:
+        """The last pose set [4×4, world]."""
+        return self.pose
+
+
+class OnlineController:
+    """A planner one control period at a time, from a start it checks.
+
+    Args:
+        planner: any articula planner (BAORNN, baornn-improved, pinv, dls, qp).
+        dt: the control period [s].
+        live: obstacle name -> its LivePose, for the obstacles step() may move.
+    """
+
+    def __init__(
+        self, planner: Planner, dt: float, live: Mapping[str, LivePose] | None = None
+    ) -> None:
+        if not (np.isfinite(dt) and dt > 0):
+            raise ConfigError("dt", f"must be finite and > 0 s (got {dt})")
+        self.planner = planner
+        self.dt = dt
+        self.live = dict(live or {})
+        self.periods = 0  # since reset; the time is periods · dt [s]
+        self.q: np.ndarray | None = None
+
+    @classmethod
+    def from_spec(
+        cls, scene: Scene, spec: PlannerSpec, seed: int = 0, live_obstacles: bool = False
+    ) -> OnlineController:
+        """The controller of a [planner] table on `scene`; with `live_obstacles`, step() takes
+        each obstacle's pose (the scene's poses are the starting ones)."""
+        live: dict[str, LivePose] = {}
+        if live_obstacles:
+            obstacles = []
+            for o in scene.obstacles:
+                live[o.name] = LivePose(o.pose_at(0.0))
+                obstacles.append(Obstacle(o.name, o.parts, live[o.name]))
+            scene = Scene(scene.robot, obstacles, scene.broadphase, scene.metric)
+        return cls(make_planner(spec, scene, seed), spec.dt, live)
+
+    def reset(self, q: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Start from q [rad] at rest, at t = 0; InfeasibleError naming `q0` for a start
+        outside the joint limits, in collision, or within d_min of an obstacle."""
+        scene, robot = self.planner.scene, self.planner.scene.robot
+        start = robot.check_q(q, "q0").copy()
+        if np.any(start < robot.lower) or np.any(start > robot.upper):
+            raise InfeasibleError("the start breaks the joint limits (Eq. 1.9)", "q0")
+        if scene.obstacles:
+            d0 = scene.min_distance(start)
+            if d0 <= 0:
+                raise InfeasibleError(f"the start collides with an obstacle (d = {d0:.4f} m)", "q0")
+            if d0 <= self.planner.d_min:
+                raise InfeasibleError(
+                    f"the start is {d0:.4f} m from an obstacle, within d_min = "
+                    f"{self.planner.d_min} m (Eq. 1.12); lower d_min or move the start",
+                    "q0",
+                )
+        self.planner.reset()
+        self.q, self.periods = start, 0
+        return start.copy()
+
+    def step(
+        self,
+        target: Sequence[float] | np.ndarray,
+        obstacle_poses: Mapping[str, np.ndarray] | None = None,
+    ) -> np.ndarray:
+        """One control period toward the end-effector target [m]; obstacle_poses moves live
+        obstacles (name -> 4×4 pose in the world) first. Returns the new configuration [rad]."""
+        if self.q is None:
+            raise ConfigError("reset", "call reset(q) with the arm's configuration first")
+        for name, pose in (obstacle_poses or {}).items():
+            if name not in self.live:
+                known = ", ".join(sorted(self.live)) or "none (build it with live_obstacles)"
+                raise ConfigError("obstacle_poses", f"no live obstacle {name!r}; live: {known}")
+            try:
+                self.live[name].pose = check_pose(name, np.asarray(pose, dtype=float))
+            except GeometryError as exc:
+                raise ConfigError(f"obstacle_poses.{name}", str(exc)) from None
+        x_ref = np.asarray(target, dtype=float)
+        if x_ref.shape != (3,) or not np.all(np.isfinite(x_ref)):
+            raise ConfigError("target", f"needs 3 finite coordinates [m] (got {x_ref.tolist()})")
+        self.q = self.planner.step(self.q, x_ref, self.t)
+        self.periods += 1
+        return self.q.copy()
+
+    @property
+    def t(self) -> float:
+        """The time of the next period [s] since reset."""
+        return self.periods * self.dt
