@@ -26,6 +26,15 @@ def articula_script() -> str:
     return ARTICULA
 
 
+@pytest.fixture(scope="session", autouse=True)
+def decomposition_cache(tmp_path_factory) -> Path:
+    """Convex decompositions cached in a folder of the test session, not the user's cache
+    (the console scripts the tests run inherit it)."""
+    folder = tmp_path_factory.mktemp("decompositions")
+    os.environ["ARTICULA_CACHE_DIR"] = str(folder)
+    return folder
+
+
 @pytest.fixture
 def tiny_config() -> dict[str, Any]:
     """A motor.current config that simulates in milliseconds (200 steps)."""

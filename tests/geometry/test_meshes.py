@@ -227,3 +227,25 @@ def test_random_bytes_in_an_stl_are_a_geometry_error_not_a_missing_module(tmp_pa
     with pytest.raises(GeometryError) as exc:
         load_mesh(path)
     assert "No module named" not in str(exc.value)
+
+
+def test_a_decomposition_is_cached_by_content_and_threshold(monkeypatch, decomposition_cache):
+    import coacd
+
+    calls = []
+    real = coacd.run_coacd
+
+    def counted(*args, **kwargs):
+        calls.append(kwargs["threshold"])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(coacd, "run_coacd", counted)
+    mesh = trimesh.creation.annulus(r_min=0.3, r_max=0.5, height=0.2)
+    first = convex_parts(mesh, "ring", decompose=True, threshold=0.1)
+    again = convex_parts(mesh, "ring", decompose=True, threshold=0.1)
+    assert calls == [0.1]  # the second came from the cache
+    for a, b in zip(first, again, strict=True):
+        np.testing.assert_array_equal(a.vertices, b.vertices)
+    convex_parts(mesh, "ring", decompose=True, threshold=0.2)
+    assert calls == [0.1, 0.2]  # another threshold is another decomposition
+    assert len(list(decomposition_cache.glob("*.npz"))) >= 2

@@ -96,3 +96,28 @@ def test_non_positive_primitive_in_urdf(build_edited):
     with pytest.raises(GeometryError) as exc:
         build_edited('<sphere radius="0.06"/>', '<sphere radius="-0.06"/>')
     assert "sphere" in str(exc.value) and "link2" in str(exc.value)
+
+
+def test_a_link_mesh_of_separate_convex_parts_keeps_one_hull_per_part(tmp_path):
+    tetra = "v {x} 0 0\nv {x1} 0 0\nv {x} 1 0\nv {x} 0 1\n"
+    faces = "f {a} {c} {b}\nf {a} {b} {d}\nf {a} {d} {c}\nf {b} {c} {d}\n"
+    obj = (tetra.format(x=0, x1=1) + faces.format(a=1, b=2, c=3, d=4)
+           + tetra.format(x=3, x1=4) + faces.format(a=5, b=6, c=7, d=8))  # fmt: skip
+    (tmp_path / "parts.obj").write_text(obj)
+    (tmp_path / "arm.urdf").write_text(
+        '<robot name="r"><link name="base"/><link name="tool"><collision><geometry>'
+        '<mesh filename="parts.obj"/></geometry></collision></link>'
+        '<joint name="j" type="revolute"><parent link="base"/><child link="tool"/>'
+        '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>'
+    )
+    (link,) = [k for k in RobotModel.from_urdf(tmp_path / "arm.urdf").links if k.shapes]
+    assert len(link.shapes) == 2
+    # A point in the gap between the parts is outside both, though inside their common hull.
+    gap = coal.Sphere(0.01)
+    request, result = coal.DistanceRequest(), coal.DistanceResult()
+    for shape in link.shapes:
+        result.clear()
+        away = coal.distance(shape.geometry, coal.Transform3s(), gap,
+                             coal.Transform3s(np.eye(3), np.array([2.0, 0.1, 0.1])), request,
+                             result)  # fmt: skip
+        assert away > 0.5

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import hashlib
+import os
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -76,11 +79,57 @@ def convex_parts(
         raise GeometryError(f"{name}: decomposition needs the coacd package") from None
     if not (0 < threshold <= 1):
         raise GeometryError(f"{name}: threshold must be in (0, 1] (got {threshold})")
-    coacd.set_log_level("error")
-    # CoACD repairs non-manifold input itself ("manifold" preprocessing); its seed is fixed so
-    # that the same file always gives the same parts.
-    parts = coacd.run_coacd(
-        coacd.Mesh(np.asarray(mesh.vertices), np.asarray(mesh.faces)),
-        threshold=threshold, preprocess_mode="auto", seed=0,
-    )  # fmt: skip
-    return [convex_hull(np.asarray(v), f"{name}[{i}]") for i, (v, _) in enumerate(parts)]
+    vertices, faces = np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces)
+    key = _cache_key(vertices, faces, threshold)
+    pieces = _cached(key)
+    if pieces is None:
+        coacd.set_log_level("error")
+        # CoACD repairs non-manifold input itself ("manifold" preprocessing); its seed is fixed
+        # so that the same file always gives the same parts.
+        parts = coacd.run_coacd(coacd.Mesh(vertices, faces), threshold=threshold,
+                                preprocess_mode="auto", seed=0)  # fmt: skip
+        pieces = [np.asarray(v, dtype=float) for v, _ in parts]
+        _store(key, pieces)
+    return [convex_hull(v, f"{name}[{i}]") for i, v in enumerate(pieces)]
+
+
+def cache_folder() -> Path:
+    """Where convex decompositions are kept: $ARTICULA_CACHE_DIR, else the user's cache."""
+    if "ARTICULA_CACHE_DIR" in os.environ:
+        return Path(os.environ["ARTICULA_CACHE_DIR"])
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "articula" / "decompositions"
+
+
+def _cache_key(vertices: np.ndarray, faces: np.ndarray, threshold: float) -> str:
+    """A decomposition's name: the mesh's content, the threshold and CoACD's version."""
+    import coacd
+
+    digest = hashlib.sha256(vertices.tobytes() + faces.astype(np.int64).tobytes())
+    digest.update(f"{threshold!r}/{getattr(coacd, '__version__', '?')}".encode())
+    return digest.hexdigest()
+
+
+def _cached(key: str) -> list[np.ndarray] | None:
+    """The parts' vertices [m] of a decomposition made before, or None."""
+    try:
+        with np.load(cache_folder() / f"{key}.npz") as data:
+            return [data[f"part{i}"] for i in range(len(data.files))]
+    except (OSError, ValueError, KeyError):
+        return None  # not there, or unreadable: decompose again
+
+
+def _store(key: str, pieces: list[np.ndarray]) -> None:
+    """Keep a decomposition for next time (written whole, or not at all)."""
+    folder = cache_folder()
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{key}.", suffix=".npz")
+    except OSError:
+        return  # a read-only home: the decomposition is only not kept
+    try:
+        with os.fdopen(fd, "wb") as f:
+            np.savez(f, **{f"part{i}": v for i, v in enumerate(pieces)})
+        os.replace(tmp, folder / f"{key}.npz")
+    except OSError:
+        Path(tmp).unlink(missing_ok=True)

@@ -7,11 +7,14 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+import trimesh
 
 from articula.errors import GeometryError, ModelError
 from articula.geometry.meshes import load_mesh
 from articula.geometry.poses import pose
 from articula.geometry.shapes import ConvexShape, box, convex_hull, cylinder, sphere
+
+MAX_LINK_PARTS = 64  # more separate parts in one link mesh: noise, not a decomposition
 
 
 def collision_shapes(
@@ -30,8 +33,9 @@ def collision_shapes(
             if geometry is None or len(geometry) == 0:
                 raise ModelError(f"{urdf}: link {name!r} has a <collision> without <geometry>")
             where = f"{urdf}: link {name!r} collision {i}"
-            shape = _shape(geometry[0], urdf, package_dirs, where)
-            shapes.setdefault(name, []).append((shape, _origin(element.find("origin"), where)))
+            origin = _origin(element.find("origin"), where)
+            for shape in _shapes(geometry[0], urdf, package_dirs, where):
+                shapes.setdefault(name, []).append((shape, origin))
     return shapes
 
 
@@ -55,22 +59,23 @@ def resolve_mesh_path(filename: str, urdf: Path, package_dirs: Sequence[Path]) -
     return path if path.is_absolute() else urdf.parent / path
 
 
-def _shape(
+def _shapes(
     element: ET.Element, urdf: Path, package_dirs: Sequence[Path], where: str
-) -> ConvexShape:
+) -> list[ConvexShape]:
+    """The convex shapes of one <geometry> child: a mesh gives one per separate part."""
     try:
         if element.tag == "mesh":
             path = resolve_mesh_path(element.get("filename", ""), urdf, package_dirs)
             scale = _floats(element.get("scale", "1 1 1"), 3, where)
-            return convex_hull(load_mesh(path, scale).vertices, str(path))
+            return mesh_parts(load_mesh(path, scale), str(path))
         if element.tag == "box":
-            return box(_floats(element.get("size", ""), 3, where))
+            return [box(_floats(element.get("size", ""), 3, where))]
         if element.tag == "cylinder":
-            return cylinder(
-                float(element.get("radius", "nan")), float(element.get("length", "nan"))
-            )
+            return [
+                cylinder(float(element.get("radius", "nan")), float(element.get("length", "nan")))
+            ]
         if element.tag == "sphere":
-            return sphere(float(element.get("radius", "nan")))
+            return [sphere(float(element.get("radius", "nan")))]
     except ValueError as exc:
         if isinstance(exc, GeometryError):
             raise GeometryError(f"{where}: {exc}") from None
@@ -78,6 +83,19 @@ def _shape(
     raise ModelError(
         f"{where}: unsupported geometry <{element.tag}>; use mesh, box, cylinder or sphere"
     )
+
+
+def mesh_parts(mesh: trimesh.Trimesh, name: str) -> list[ConvexShape]:
+    """One convex hull per separate part of a link mesh (a V-HACD file holds its convex
+    pieces as separate parts; one hull over them all would fill the gaps between them), or
+    the hull of the whole mesh when it is one part, has too many, or a part has no volume."""
+    pieces = mesh.split(only_watertight=False)
+    if 1 < len(pieces) <= MAX_LINK_PARTS:
+        try:
+            return [convex_hull(p.vertices, f"{name}[{i}]") for i, p in enumerate(pieces)]
+        except GeometryError:
+            pass  # a flat piece: its hull has no volume
+    return [convex_hull(mesh.vertices, name)]
 
 
 def _origin(element: ET.Element | None, where: str) -> np.ndarray:
