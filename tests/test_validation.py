@@ -148,3 +148,11 @@ def test_fields_as_lets_other_exceptions_and_results_through():
     with fields_as({"q0": "robot.q0"}):
         value = 1 + 1
     assert value == 2
+
+
+def test_a_union_fields_error_names_the_key_not_pydantics_member_tag():
+    from articula.scene.config import ObstacleSpec
+
+    with pytest.raises(ConfigError) as err:
+        parse_model(ObstacleSpec, {"mesh": "m.stl", "scale": 1e308}, "scene.toml")
+    assert err.value.field == "scene.toml: scale"

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import tomllib
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
@@ -64,7 +65,9 @@ def config_error_from(exc: ValidationError, where: str = "", owner: str = "") ->
     "Owner.a.b".
     """
     first = exc.errors()[0]
-    loc = tuple(str(p) for p in first["loc"])
+    # Keys and list indices only: pydantic adds the name of a union's member it tried
+    # ("constrained-float", "list[...]"), which is no key of the user's file.
+    loc = tuple(str(p) for p in first["loc"] if re.fullmatch(r"\w+", str(p)))
     inner = first.get("ctx", {}).get("error")
     if isinstance(inner, ConfigError) and inner.loc is not None:
         # A nested StrictModel already turned its own failure into a ConfigError.
