@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import re
 import tomllib
-from collections.abc import Iterator, Mapping
-from contextlib import contextmanager
+from collections.abc import Callable, Iterator, Mapping
+from contextlib import AbstractContextManager, contextmanager
 from pathlib import Path
 from typing import Annotated, Any, TypeVar
 
@@ -87,19 +87,27 @@ def config_error_from(exc: ValidationError, where: str = "", owner: str = "") ->
 
 
 @contextmanager
-def fields_as(paths: Mapping[str, str]) -> Iterator[None]:
-    """Rename the field of a ConfigError or InfeasibleError raised inside, from the argument
-    name the library used to the config path the user wrote (e.g. "q0" -> "robot.q0")."""
+def fields_renamed(rename: Callable[[str | None], str | None]) -> Iterator[None]:
+    """Re-raise a ConfigError or InfeasibleError raised inside with its field renamed by
+    `rename` (which returns None to leave an error as it is)."""
     try:
         yield
     except ConfigError as exc:
-        if exc.field not in paths:
+        field = rename(exc.field)
+        if field is None:
             raise
-        raise ConfigError(paths[exc.field], exc.problem) from None
+        raise ConfigError(field, exc.problem) from None
     except InfeasibleError as exc:
-        if exc.field not in paths:
+        field = rename(exc.field)
+        if field is None:
             raise
-        raise InfeasibleError(exc.problem, paths[exc.field]) from None
+        raise InfeasibleError(exc.problem, field) from None
+
+
+def fields_as(paths: Mapping[str, str]) -> AbstractContextManager[None]:
+    """Rename error fields from the argument name the library used to the config path the
+    user wrote (e.g. "q0" -> "robot.q0"); other errors pass unchanged."""
+    return fields_renamed(lambda field: paths.get(field) if field is not None else None)
 
 
 def load_toml(path: Path) -> dict[str, Any]:

@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Iterator, Mapping, Sequence
-from contextlib import contextmanager
+from collections.abc import Callable, Mapping, Sequence
+from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -12,11 +12,12 @@ from typing import Any
 import numpy as np
 import pyarrow as pa
 
-from articula.errors import ConfigError, InfeasibleError
+from articula.errors import InfeasibleError
 from articula.runs import records
 from articula.runs.backends import check_backend, execute_all
 from articula.runs.folders import RESULTS, check_out, claimed
 from articula.runs.registry import Progress, Result, config_to_dict, parse_config
+from articula.validation import fields_renamed
 
 FLAT_LIST_LIMIT = 16  # results.parquet spreads a config list this long or shorter into columns
 
@@ -44,22 +45,12 @@ def execute(
     return RunOutput(full, records.build_record(full, result, wall), result.trace)
 
 
-@contextmanager
-def named_by_file(where: str) -> Iterator[None]:
+def named_by_file(where: str) -> AbstractContextManager[None]:
     """Prefix the field of a ConfigError or InfeasibleError raised inside with `where` (the
-    config's file), as validation errors are."""
-    try:
-        yield
-    except ConfigError as exc:
-        if not where:
-            raise
-        raise ConfigError(f"{where}: {exc.field}", exc.problem) from None
-    except InfeasibleError as exc:
-        if not where:
-            raise
-        raise InfeasibleError(
-            exc.problem, f"{where}: {exc.field}" if exc.field else where
-        ) from None
+    config's file), as validation errors are; without `where`, leave errors as they are."""
+    if not where:
+        return nullcontext()
+    return fields_renamed(lambda field: f"{where}: {field}" if field else where)
 
 
 def execute_or_fail(config: Mapping[str, Any]) -> RunOutput:
