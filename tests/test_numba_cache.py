@@ -74,7 +74,7 @@ def test_cached_compiled_chain_equals_a_fresh_composition():
         cached = _evaluate(q, *compiled.arrays(), compiled.static_min)
         fresh = _evaluate.py_func(q, *compiled.arrays(), compiled.static_min)
         assert cached[0] == pytest.approx(fresh[0], abs=1e-12)
-        assert np.allclose(cached[1], fresh[1], atol=1e-15, rtol=0)
+        assert np.allclose(cached[2], fresh[2], atol=1e-15, rtol=0)
 
 
 def _load(folder: Path, name: str) -> ModuleType:

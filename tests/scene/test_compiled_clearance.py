@@ -23,7 +23,8 @@ def test_mesh_scene_agrees_with_coal_including_overlaps():
     rng = np.random.default_rng(7)
     overlaps = 0
     for q in rng.uniform(ROBOT.lower, ROBOT.upper, (400, ROBOT.nq)):
-        d, ee = compiled.evaluate(q)
+        d, d_self, ee = compiled.evaluate(q)
+        assert d_self == np.inf  # no self pairs in this scene
         reference = scene.min_distance(q)
         overlaps += reference <= 0
         # coal's GJK stops at its own tolerance; overlaps are clearance 0 here.
@@ -61,3 +62,24 @@ def test_moving_obstacles_and_cylinders_have_no_compiled_form():
     assert CompiledClearance.build(Scene(ROBOT, [moving])) is None
     round_rim = Obstacle("c", (cylinder(0.05, 0.2),), pose([0.3, 0.3, 0.5]))
     assert CompiledClearance.build(Scene(ROBOT, [round_rim])) is None
+
+
+def test_self_pairs_agree_with_coal_and_stay_apart_from_obstacles():
+    pairs = [("iiwa_link_0", "iiwa_link_5"), ("iiwa_link_1", "iiwa_link_6"),
+             ("iiwa_link_5", "iiwa_link_7"), ("iiwa_link_2", "iiwa_link_7")]  # fmt: skip
+    obstacle = Obstacle("o", (sphere(0.07),), pose([0.3, 0.3, 0.6]))
+    scene = Scene(ROBOT, [obstacle], self_pairs=pairs)
+    compiled = CompiledClearance.build(scene)
+    rng = np.random.default_rng(11)
+    touching = 0
+    for q in rng.uniform(ROBOT.lower, ROBOT.upper, (300, ROBOT.nq)):
+        d, d_self, _ = compiled.evaluate(q)
+        obstacles, itself = scene.clearances(q)
+        assert itself == pytest.approx(scene.self_distances(q).min(), abs=1e-12)
+        touching += itself <= 0
+        assert d == pytest.approx(max(obstacles, 0.0), abs=1e-6)
+        assert d_self == pytest.approx(max(itself, 0.0), abs=1e-6)
+        only_self = compiled.evaluate(q, obstacles=False)
+        assert only_self[0] == np.inf
+        assert only_self[1] == pytest.approx(d_self, abs=1e-12)
+    assert touching > 0  # the sample did reach self-overlap

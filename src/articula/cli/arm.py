@@ -84,8 +84,8 @@ def scene_check(
     ] = None,
     as_json: JsonFlag = False,
 ) -> None:
-    """End-effector position and link-obstacle clearances of a scene at q0, --q or each row of
-    --q-file."""
+    """End-effector position, link-obstacle clearances and self clearance of a scene at q0, --q
+    or each row of --q-file."""
     from articula.scene.check import check_scene
 
     result = check_scene(scene_file, q, metric, q_file)
@@ -93,12 +93,18 @@ def scene_check(
         emit_json(result)
         return
     if q_file is not None:
-        rows = [(str(i), f"{r['min_clearance']:.4f}{' collides' if r['collides'] else ''}")
+        rows = [(str(i), f"{r['min_clearance']:.4f}{' collides' if r['collides'] else ''}",
+                 f"{r['self_clearance']:.4f}{' collides' if r['self_collides'] else ''}")
                 for i, r in enumerate(result["configurations"])]  # fmt: skip
-        print_table(f"{scene_file} ({metric} metric)", ("row", "min clearance [m]"), rows)
+        header = ("row", "min clearance [m]", "self clearance [m]")
+        print_table(f"{scene_file} ({metric} metric)", header, rows)
         return
     rows = [(name, f"{value:.4f}") for name, value in result["link_clearance"].items()]
     print_table(f"{scene_file} ({metric} metric)", ("link", "clearance [m]"), rows)
     x, y, z = result["ee_position"]
     out.print(f"end-effector at ({x:.4f}, {y:.4f}, {z:.4f}) m; minimum clearance "
               f"{result['min_clearance']:.4f} m; collides: {result['collides']}")  # fmt: skip
+    pair = " and ".join(result["self_closest_pair"] or ["no link pair"])
+    checked = "" if result["self_collision_checked"] else " (self_collision is off)"
+    out.print(f"self clearance {result['self_clearance']:.4f} m ({pair}); self collides: "
+              f"{result['self_collides']}{checked}")  # fmt: skip

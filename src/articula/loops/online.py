@@ -65,18 +65,30 @@ class OnlineController:
             for o in scene.obstacles:
                 live[o.name] = LivePose(o.pose_at(0.0))
                 obstacles.append(Obstacle(o.name, o.parts, live[o.name]))
-            scene = Scene(scene.robot, obstacles, scene.broadphase, scene.metric)
+            scene = Scene(scene.robot, obstacles, scene.broadphase, scene.metric,
+                          scene.self_pair_names)  # fmt: skip
         return cls(make_planner(spec, scene, seed), spec.dt, live)
 
     def reset(self, q: Sequence[float] | np.ndarray) -> np.ndarray:
         """Start from q [rad] at rest, at t = 0; InfeasibleError naming `q0` for a start
-        outside the joint limits, in collision, or within d_min of an obstacle."""
+        outside the joint limits, in collision (with an obstacle or, for a checked link pair,
+        with itself), or within d_min of an obstacle."""
         scene, robot = self.planner.scene, self.planner.scene.robot
         start = robot.check_q(q, "q0").copy()
         if np.any(start < robot.lower) or np.any(start > robot.upper):
             raise InfeasibleError("the start breaks the joint limits (Eq. 1.9)", "q0")
+        if scene.self_pairs:
+            d_self = scene.self_distances(start)
+            k = int(np.argmin(d_self))
+            if d_self[k] <= 0:
+                a, b = scene.self_pair_names[k]
+                raise InfeasibleError(
+                    f"the start collides with itself: links {a} and {b} (d = {d_self[k]:.4f} m); "
+                    "move the start or allow the pair in robot.allow_pairs",
+                    "q0",
+                )
         if scene.obstacles:
-            d0 = scene.min_distance(start)
+            d0 = scene.clearances(start)[0]
             if d0 <= 0:
                 raise InfeasibleError(f"the start collides with an obstacle (d = {d0:.4f} m)", "q0")
             if d0 <= self.planner.d_min:

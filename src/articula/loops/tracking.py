@@ -19,7 +19,8 @@ Trajectory = Callable[[float], np.ndarray]
 
 @dataclass(frozen=True)
 class PlanResult:
-    """Time series of a tracking run: t [s], q [rad], x and x_ref [m], error and clearance [m]."""
+    """Time series of a tracking run: t [s], q [rad], x and x_ref [m], error and clearance [m]
+    (to obstacles and, with self-collision on, between checked link pairs)."""
 
     t: np.ndarray
     q: np.ndarray
@@ -76,7 +77,7 @@ def track(
         planner_seconds += time.perf_counter() - start
         qs[n] = q
         x[n] = robot.ee_position(q)
-        if scene.obstacles:
+        if scene.has_clearance:
             clearance[n] = scene.min_distance(q, tn)
     error = np.linalg.norm(x - x_ref, axis=1)
     return PlanResult(t, qs, x, x_ref, error, clearance, planner_seconds, q_start)

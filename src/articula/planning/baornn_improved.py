@@ -101,11 +101,12 @@ class ImprovedBaornn(BeetleSearch):
     ) -> tuple[np.ndarray, float]:
         """The iterations of `draws` by planning/baornn_kernel.py."""
         obj, p = self.objective, self.params
-        (lambda_weight, beta, d_min, use_distance, lower, upper, arrays,
-         static_min) = obj.kernel_arguments(self._box)  # fmt: skip
+        lambda_weight, beta, d_min, lower, upper, arrays, static_min = obj.kernel_arguments(
+            self._box
+        )
         q, g, evaluations = kernel.improved_iterations(
-            q, g, x_ref, draws, p.c1, p.c2, lambda_weight, beta, d_min, use_distance, lower,
-            upper, arrays, obj.kinematics_arguments(), static_min,
+            q, g, x_ref, draws, p.c1, p.c2, lambda_weight, beta, d_min, lower, upper, arrays,
+            obj.kinematics_arguments(), static_min,
         )  # fmt: skip
         self.evaluations += evaluations
         self.iterations += draws.shape[0]

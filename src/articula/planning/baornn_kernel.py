@@ -16,26 +16,27 @@ from articula.scene.compiled_clearance import _evaluate
 
 @jit()
 def _project_and_value(
-    q, q_current, g_current, x_ref, lambda_weight, beta, d_min, use_distance, lower, upper,
-    arrays, static_min,
+    q, q_current, g_current, x_ref, lambda_weight, beta, d_min, lower, upper, arrays,
+    static_min,
 ):  # fmt: skip
     """(P_Ω(q), g there), Eqs. (1.17)-(1.18); stays at (q_current, g_current) unless the
-    clipped point keeps d > d_min (1.12): clearance is 0 on overlap, so d_min = 0 still
-    rejects a point inside an obstacle."""
+    clipped point keeps d > d_min (1.12) and clear of itself: clearance is 0 on overlap, so
+    d_min = 0 still rejects a point inside an obstacle. The pairs in `arrays` are the ones
+    that count (an obstacle clearance of +inf: none)."""
     clipped = np.minimum(np.maximum(q, lower), upper)
-    d, ee = _evaluate(clipped, *arrays, static_min)
-    if use_distance and d <= d_min:
+    d, d_self, ee = _evaluate(clipped, *arrays, static_min)
+    if d <= d_min or d_self <= 0.0:
         return q_current, g_current
     ex, ey, ez = x_ref[0] - ee[0], x_ref[1] - ee[1], x_ref[2] - ee[2]
     g = math.sqrt(ex * ex + ey * ey + ez * ez)  # Eq. (1.5)
-    if lambda_weight > 0.0 and use_distance:
+    if lambda_weight > 0.0 and d < np.inf:
         g += lambda_weight / d**beta if d > 0.0 else np.inf  # Eq. (1.7)
     return clipped, g
 
 
 @jit()
 def iterations(
-    q, g, x_ref, directions, c1, c2, lambda_weight, beta, d_min, use_distance, lower, upper,
+    q, g, x_ref, directions, c1, c2, lambda_weight, beta, d_min, lower, upper,
     arrays, static_min,
 ):  # fmt: skip
     """Run one iteration of Algorithm 1 per row of `directions` (raw Gaussian draws, normalised
@@ -44,16 +45,16 @@ def iterations(
         b = directions[k] / math.sqrt(directions[k] @ directions[k])
         lam = c1 * math.sqrt(g) if math.isfinite(g) else c1  # Eq. (1.23)
         _, g_left = _project_and_value(q + lam * b, q, g, x_ref, lambda_weight, beta,
-                                            d_min, use_distance, lower, upper, arrays,
+                                            d_min, lower, upper, arrays,
                                             static_min)  # fmt: skip
         _, g_right = _project_and_value(q - lam * b, q, g, x_ref, lambda_weight, beta,
-                                              d_min, use_distance, lower, upper, arrays,
+                                              d_min, lower, upper, arrays,
                                               static_min)  # fmt: skip
         diff = g_left - g_right
         sign = 1.0 if diff > 0.0 else (-1.0 if diff < 0.0 else 0.0)  # 0 when both are inf
         step = q - c2 * lam * sign * b  # Eqs. (1.19), (1.24)
         q_new, g_new = _project_and_value(step, q, g, x_ref, lambda_weight, beta, d_min,
-                                          use_distance, lower, upper, arrays,
+                                          lower, upper, arrays,
                                           static_min)  # fmt: skip
         if g_new < g:  # Eqs. (1.21)-(1.22)
             q, g = q_new, g_new
@@ -62,7 +63,7 @@ def iterations(
 
 @jit()
 def improved_iterations(
-    q, g, x_ref, draws, c1, c2, lambda_weight, beta, d_min, use_distance, lower, upper,
+    q, g, x_ref, draws, c1, c2, lambda_weight, beta, d_min, lower, upper,
     arrays, kinematics, static_min,
 ):  # fmt: skip
     """baornn-improved's iterations (planning/baornn_improved.py), one per draws[k], an
@@ -71,7 +72,7 @@ def improved_iterations(
     n = q.size
     evaluations = 0
     for k in range(draws.shape[0]):
-        _, ee = _evaluate(q, *kinematics, np.inf)
+        _, _, ee = _evaluate(q, *kinematics, static_min)
         ex, ey, ez = x_ref[0] - ee[0], x_ref[1] - ee[1], x_ref[2] - ee[2]
         lam = c1 * math.sqrt(math.sqrt(ex * ex + ey * ey + ez * ez))  # c1·√e_k
         directions, _ = np.linalg.qr(draws[k])
@@ -80,10 +81,10 @@ def improved_iterations(
         for j in range(directions.shape[1]):
             b = np.ascontiguousarray(directions[:, j])
             q_left, g_left = _project_and_value(q + lam * b, q, g, x_ref, lambda_weight, beta,
-                                                d_min, use_distance, lower, upper, arrays,
+                                                d_min, lower, upper, arrays,
                                                 static_min)  # fmt: skip
             q_right, g_right = _project_and_value(q - lam * b, q, g, x_ref, lambda_weight,
-                                                  beta, d_min, use_distance, lower, upper,
+                                                  beta, d_min, lower, upper,
                                                   arrays, static_min)  # fmt: skip
             evaluations += 2
             if math.isfinite(g_left) and math.isfinite(g_right):
@@ -96,7 +97,7 @@ def improved_iterations(
         if norm > 0.0:
             step = q - c2 * lam * gradient / norm  # Eq. (1.19) along the estimated gradient
             q_new, g_new = _project_and_value(step, q, g, x_ref, lambda_weight, beta, d_min,
-                                              use_distance, lower, upper, arrays,
+                                              lower, upper, arrays,
                                               static_min)  # fmt: skip
             evaluations += 1
             if g_new < best_g:  # Eqs. (1.21)-(1.22)

@@ -43,20 +43,21 @@ class Objective:
             object.__setattr__(self, "compiled", CompiledClearance.build(self.scene))
 
     def kernel_arguments(self, box: Box | None = None) -> tuple:
-        """Λ, β, d_min, whether distances count, the projection box (default: the joint
-        limits) and the compiled scene arrays, in the order of planning.baornn_kernel
-        (requires `compiled`)."""
+        """Λ, β, d_min, the projection box (default: the joint limits), the compiled scene
+        arrays with the pairs that count and their static minima, in the order of
+        planning.baornn_kernel (requires `compiled`)."""
         robot, c = self.scene.robot, self.compiled
         if c is None:
             raise ModelError("this scene has no compiled evaluation (see Objective.compiled)")
-        pairs = None if self.needs_distance else c.no_pairs  # Λ = d_min = 0: no GJK at all
+        pairs, static_min = c.select(self.needs_obstacles, True)
         lower, upper = box or (robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
-        return (self.lambda_weight, self.beta, self.d_min, self.needs_distance, lower, upper,
-                c.arrays(pairs), c.static_min)  # fmt: skip
+        return (self.lambda_weight, self.beta, self.d_min, lower, upper, c.arrays(pairs),
+                static_min)  # fmt: skip
 
     @property
-    def needs_distance(self) -> bool:
-        """False when neither the penalty nor the hard bound uses the obstacles (Λ = d_min = 0)."""
+    def needs_obstacles(self) -> bool:
+        """False when neither the penalty nor the hard bound uses the obstacles (Λ = d_min = 0):
+        then no link-obstacle distance is computed at all."""
         return bool(self.scene.obstacles) and (self.lambda_weight > 0 or self.d_min > 0)
 
     def kinematics_arguments(self) -> tuple:
@@ -68,15 +69,15 @@ class Objective:
     def value(self, q: np.ndarray, x_ref: np.ndarray, t: float = 0.0) -> float:
         """Objective g at configuration q [rad] for the reference point x_ref [m]."""
         if self.compiled is not None:
-            d, ee = self.compiled.evaluate(q, self.needs_distance)
+            d, _, ee = self.compiled.evaluate(q, self.needs_obstacles, False)
             return self._combine(x_ref - ee, d)
-        d = self.scene.min_distance(q, t) if self.needs_distance else np.inf
+        d = self.scene.clearances(q, t)[0] if self.needs_obstacles else np.inf
         return self._value(q, x_ref, d)
 
     def tracking_error(self, q: np.ndarray, x_ref: np.ndarray) -> float:
         """The tracking term ||x_r − f(θ)|| [m] of g alone, Eq. (1.5)."""
         if self.compiled is not None:
-            e = x_ref - self.compiled.evaluate(q, False)[1]
+            e = x_ref - self.compiled.evaluate(q, False, False)[2]
             return math.sqrt(e @ e)
         robot = self.scene.robot
         robot.forward(q)
@@ -94,18 +95,20 @@ class Objective:
     ) -> tuple[np.ndarray, float]:
         """(P_Ω(q), g there), Eqs. (1.17)-(1.18): clip to the joint limits (1.9), or to `box`
         (the joint limits narrowed by speed limits); if the clipped point is closer than d_min
-        to an obstacle, stay at (q_current, g_current). One distance query serves both the
-        constraint and the penalty."""
+        to an obstacle or touches itself (a checked link pair), stay at (q_current, g_current).
+        One distance query serves both the constraints and the penalty."""
         clipped = self.scene.robot.clip(q) if box is None else np.clip(q, *box)
         if self.compiled is not None:
-            d, ee = self.compiled.evaluate(clipped, self.needs_distance)
-            if self.needs_distance and d <= self.d_min:  # Ω: d > d_min (1.12); 0 on overlap
+            d, d_self, ee = self.compiled.evaluate(clipped, self.needs_obstacles)
+            if d <= self.d_min or d_self <= 0:  # Ω: d > d_min (1.12); 0 on overlap
                 return q_current, g_current
             return clipped, self._combine(x_ref - ee, d)
-        if not self.needs_distance:
+        if not (self.needs_obstacles or self.scene.self_pairs):
             return clipped, self._value(clipped, x_ref, np.inf)
-        d = self.scene.min_distance(clipped, t)  # also leaves the joint placements updated
-        if d <= self.d_min:  # Ω is d > d_min (1.12)
+        d, d_self = self.scene.clearances(clipped, t)  # also leaves the joint placements updated
+        if not self.needs_obstacles:
+            d = np.inf
+        if d <= self.d_min or d_self <= 0:  # Ω is d > d_min (1.12), and clear of itself
             return q_current, g_current
         return clipped, self._value(clipped, x_ref, d, kinematics_done=True)
 
@@ -123,7 +126,7 @@ class Objective:
     def _combine(self, e: np.ndarray, d: float) -> float:
         """g from the tracking error vector e [m] and the clearance d [m]."""
         g = math.sqrt(e @ e)  # Eq. (1.5); np.linalg.norm costs more than the rest for 3 numbers
-        if self.lambda_weight > 0 and self.scene.obstacles:
+        if self.lambda_weight > 0 and d < np.inf:
             # Eq. (1.7): inside an obstacle the penalty has no finite value.
             g += self.lambda_weight / d**self.beta if d > 0 else np.inf
         return g

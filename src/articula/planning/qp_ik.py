@@ -1,5 +1,5 @@
 """Reactive QP baseline after Haviland & Corke's NEO: velocity dampers on link-obstacle
-distances and joint limits, a slack on the end-effector velocity, solved every period."""
+distances (and checked link-link ones), joint limits, a slack on the end-effector velocity, solved every period."""
 
 from __future__ import annotations
 
@@ -22,6 +22,8 @@ class QpIkParams(RateParams):
         joint_weight: λ_q [-]; slack_weight: λ_δ [-].
         damper_gain: ξ [m/s] (rad/s for joint limits).
         safety: d_s [m]; with influence d_i, ḋ ≥ −ξ (d − d_s)/(d_i − d_s) for d < d_i.
+        self_safety: d_s for two links of the arm [m] (checked self-collision pairs): smaller,
+            as some sit closer than `safety` by design.
         limit_influence, limit_safety: the same damper on the distance to each joint limit [rad].
     """
 
@@ -29,13 +31,15 @@ class QpIkParams(RateParams):
     slack_weight: NonNegative = 100.0
     damper_gain: NonNegative = 1.0
     safety: NonNegative = 0.03
+    self_safety: NonNegative = 0.005
     limit_influence: NonNegative = 0.2
     limit_safety: NonNegative = 0.02
 
     @model_validator(mode="after")
     def _safety_inside_influence(self) -> QpIkParams:
-        if self.safety >= self.influence:
-            raise field_error("safety", f"must be smaller than influence = {self.influence} m")
+        for name in ("safety", "self_safety"):
+            if getattr(self, name) >= self.influence:
+                raise field_error(name, f"must be smaller than influence = {self.influence} m")
         if self.limit_safety >= self.limit_influence:
             raise field_error(
                 "limit_safety", f"must be smaller than limit_influence = {self.limit_influence} rad"
@@ -77,14 +81,15 @@ class QpIk:
         P = np.diag(np.r_[np.full(n, p.joint_weight), np.full(3, p.slack_weight)])
         A = np.hstack([J, np.eye(3)])
         G_rows, h_rows = [], []
-        if self.scene.obstacles:
+        if self.scene.has_clearance:
             rows = clearance_rows(self.scene, q, t, p.influence)
-            for d, grad in zip(rows.distance, rows.gradient, strict=True):
+            for d, grad, itself in zip(rows.distance, rows.gradient, rows.self_pair, strict=True):
                 if not np.any(grad):
                     continue  # a world-fixed link: no joint changes d, so no row can help
                 # −∇d·q̇ ≤ ξ (d − d_s)/(d_i − d_s): approach no faster than the damper allows.
+                safety = p.self_safety if itself else p.safety
                 G_rows.append(np.r_[-grad, np.zeros(3)])
-                h_rows.append(p.damper_gain * (d - p.safety) / (p.influence - p.safety))
+                h_rows.append(p.damper_gain * (d - safety) / (p.influence - safety))
         for j in range(n):
             for sign, room in ((1.0, robot.upper[j] - q[j]), (-1.0, q[j] - robot.lower[j])):
                 if room < p.limit_influence:

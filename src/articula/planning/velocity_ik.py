@@ -69,7 +69,7 @@ class VelocityIk:
 
     def _repulsion(self, q: np.ndarray, t: float) -> np.ndarray:
         p = self.params
-        if not self.scene.obstacles or p.repulsion == 0:
+        if not self.scene.has_clearance or p.repulsion == 0:
             return np.zeros(q.size)
         rows = clearance_rows(self.scene, q, t, p.influence)
         d = np.maximum(rows.distance, 1e-3)  # inside an obstacle: push as hard as at 1 mm

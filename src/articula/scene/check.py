@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from articula.errors import ConfigError
-from articula.scene.config import build_scene, load_scene_spec
+from articula.scene.config import build_scene, load_scene_spec, robot_self_collision
 from articula.scene.scene import Scene
 from articula.validation import load_toml
 
@@ -67,18 +67,27 @@ def check_scene(
     if q_text is not None and q_file is not None:
         raise ConfigError("--q-file", "give --q or --q-file, not both")
     scene, q0 = build_scene(spec, path.parent, metric="vertex" if metric == "vertex" else "gjk")
+    # Self distances over the pairs the scene checks; with self_collision off, over the pairs
+    # it would check, so that the answer says whether turning it on matters.
+    itself = scene
+    if not scene.self_pairs:
+        checked = robot_self_collision(spec, scene.robot).checked
+        itself = Scene(scene.robot, [], metric=scene.metric, self_pairs=checked)
     if q_file is not None:
         rows = read_q_file(q_file, scene.robot.nq)
-        return {"configurations": [_check(scene, scene.robot.check_q(q, "--q-file"), metric)
-                                   for q in rows]}  # fmt: skip
+        return {"configurations": [_check(scene, itself, scene.robot.check_q(q, "--q-file"),
+                                          metric) for q in rows]}  # fmt: skip
     q = q0 if q_text is None else scene.robot.check_q(parse_q(q_text), "--q")
-    return _check(scene, q, metric)
+    return _check(scene, itself, q, metric)
 
 
-def _check(scene: Scene, q: np.ndarray, metric: str) -> dict[str, Any]:
-    """The summary of one configuration."""
+def _check(scene: Scene, itself: Scene, q: np.ndarray, metric: str) -> dict[str, Any]:
+    """The summary of one configuration; `itself` holds the link pairs to check."""
     d = scene.distances(q)
     min_clearance = float(d.min()) if d.size else float("inf")
+    d_self = itself.self_distances(q)
+    closest = int(np.argmin(d_self)) if d_self.size else None
+    self_clearance = float(d_self[closest]) if closest is not None else float("inf")
     return {
         "q": q.tolist(),
         "ee_position": scene.robot.ee_position(q).tolist(),
@@ -90,7 +99,11 @@ def _check(scene: Scene, q: np.ndarray, metric: str) -> dict[str, Any]:
         "obstacle_clearance": {
             o.name: float(col.min()) for o, col in zip(scene.obstacles, d.T, strict=True)
         },
-        "collides": bool(min_clearance < 0.0),
+        "self_clearance": self_clearance,
+        "self_closest_pair": None if closest is None else list(itself.self_pair_names[closest]),
+        "self_collides": bool(self_clearance < 0.0),
+        "self_collision_checked": bool(scene.self_pairs),
+        "collides": bool(min_clearance < 0.0 or (scene.self_pairs and self_clearance < 0.0)),
         "within_limits": bool(np.all((q >= scene.robot.lower) & (q <= scene.robot.upper))),
         "metric": metric,
     }

@@ -6,7 +6,8 @@ evaluation is a dozen Python-level calls into C++ (about 1 µs each, see docs/ar
 Here the whole evaluation is one numba function over arrays taken from the same Scene. It
 covers the common case (revolute joints; polytope, sphere and capsule shapes; obstacles that
 do not move) and `CompiledClearance.build` returns None otherwise, so callers fall back to
-Scene.min_distance. Clearance is GJK distance, and 0 when shapes overlap (no depth).
+Scene.min_distance. Clearance is GJK distance, and 0 when shapes overlap (no depth); the
+obstacle clearance and the self clearance (the scene's checked link pairs) come out apart.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from articula.numba_cache import jit
 from articula.scene.gjk import gjk_distance
 from articula.scene.scene import Scene
 
+OBSTACLE, SELF = 0, 1  # the kinds of pair: link-obstacle, link-link
 _AXES = {"JointModelRX": (1.0, 0.0, 0.0), "JointModelRY": (0.0, 1.0, 0.0),
          "JointModelRZ": (0.0, 0.0, 1.0)}  # fmt: skip
 
@@ -51,8 +53,8 @@ class CompiledClearance:
     capsule_a: np.ndarray  # (shapes, 3) ends of each bounding capsule, in the shape's frame
     capsule_b: np.ndarray
     capsule_r: np.ndarray
-    pairs: np.ndarray  # (pairs, 3) (link shape, obstacle shape, guess row) that can move
-    static_min: float  # smallest distance of the pairs that never move
+    pairs: np.ndarray  # (pairs, 4) (shape, shape, guess row, OBSTACLE | SELF) that can move
+    static_min: np.ndarray  # (2,) smallest distance of the pairs that never move, per kind
 
     @classmethod
     def build(cls, scene: Scene) -> CompiledClearance | None:
@@ -63,14 +65,15 @@ class CompiledClearance:
             return None
         if any(name not in _AXES and name != "JointModelRevoluteUnaligned" for name in names):
             return None
-        shapes, joints, poses = [], [], []
-        # Without obstacles only the kinematics are needed: no shape at all.
-        for link in scene.robot.links if scene.obstacles else ():
+        shapes, joints, poses, owner = [], [], [], []
+        # Without anything to keep clear of only the kinematics are needed: no shape at all.
+        for li, link in enumerate(scene.robot.links if scene.has_clearance else ()):
             frame = model.frames[link.frame_id]
             for shape, T in zip(link.shapes, link.placements, strict=True):
                 shapes.append(shape)
                 joints.append(frame.parentJoint)
                 poses.append((frame.placement * pin.SE3(T)).homogeneous)
+                owner.append(li)
         n_links = len(shapes)
         for obstacle in scene.obstacles:
             for part in obstacle.parts:
@@ -88,10 +91,12 @@ class CompiledClearance:
             name = joint.shortname()
             axes[j] = _AXES[name] if name in _AXES else joint.extract().axis
         bounds = [_capsule_ends(s) for s in shapes]
-        pairs = [(a, b) for a in range(n_links) for b in range(n_links, len(shapes))]
-        moving = [(a, b) for a, b in pairs if joints[a] != 0]
+        pairs = [(a, b, OBSTACLE) for a in range(n_links) for b in range(n_links, len(shapes))]
+        pairs += [(a, b, SELF) for la, lb in scene.self_pairs for a in range(n_links)
+                  for b in range(n_links) if (owner[a], owner[b]) == (la, lb)]  # fmt: skip
+        moving = [(a, b, kind) for a, b, kind in pairs if joints[a] != 0 or joints[b] != 0]
         index = {pair: k for k, pair in enumerate(pairs)}
-        fixed = [(a, b) for a, b in pairs if joints[a] == 0]
+        fixed = [pair for pair in pairs if pair not in moving]
         placements = model.jointPlacements
         out = cls(
             parents=np.array(model.parents, dtype=np.int64),
@@ -114,24 +119,30 @@ class CompiledClearance:
             capsule_a=np.array([b[0] for b in bounds]).reshape(-1, 3),
             capsule_b=np.array([b[1] for b in bounds]).reshape(-1, 3),
             capsule_r=np.array([b[2] for b in bounds], dtype=float),
-            pairs=np.array([(a, b, index[a, b]) for a, b in moving], dtype=np.int64).reshape(-1, 3),
-            static_min=np.inf,
+            pairs=_pair_rows(moving, index),
+            static_min=np.full(2, np.inf),
         )
         if fixed:
             q0 = np.zeros(model.nq)
-            fixed_pairs = np.array([(a, b, index[a, b]) for a, b in fixed], dtype=np.int64)
-            static = _evaluate(q0, *out.arrays(fixed_pairs), np.inf)[0]
-            object.__setattr__(out, "static_min", static)
+            static = _evaluate(q0, *out.arrays(_pair_rows(fixed, index)), np.full(2, np.inf))
+            object.__setattr__(out, "static_min", np.array(static[:2]))
         return out
 
-    no_pairs: ClassVar[np.ndarray] = np.zeros((0, 3), dtype=np.int64)  # kinematics only
+    no_pairs: ClassVar[np.ndarray] = np.zeros((0, 4), dtype=np.int64)  # kinematics only
 
-    def evaluate(self, q: np.ndarray, distances: bool = True) -> tuple[float, np.ndarray]:
-        """(clearance [m], end-effector position [m]) at q [rad]; clearance 0 on overlap and
-        +inf without obstacles or with `distances` False (kinematics only)."""
-        if not distances:
-            return _evaluate(q, *self.arrays(self.no_pairs), np.inf)
-        return _evaluate(q, *self.arrays(), self.static_min)
+    def evaluate(
+        self, q: np.ndarray, obstacles: bool = True, self_pairs: bool = True
+    ) -> tuple[float, float, np.ndarray]:
+        """(obstacle clearance [m], self clearance [m], end-effector position [m]) at q [rad];
+        a clearance is 0 on overlap and +inf without pairs of its kind or when not asked for
+        (both False: kinematics only)."""
+        pairs, static_min = self.select(obstacles, self_pairs)
+        return _evaluate(q, *self.arrays(pairs), static_min)
+
+    def select(self, obstacles: bool, self_pairs: bool) -> tuple[np.ndarray, np.ndarray]:
+        """(pairs, static_min) of the kinds asked for; the others count as +inf."""
+        keep = np.array([obstacles, self_pairs])
+        return self.pairs[keep[self.pairs[:, 3]]], np.where(keep, self.static_min, np.inf)
 
     def arrays(self, pairs: np.ndarray | None = None) -> tuple:
         """The arguments of the compiled evaluation after q (all but static_min)."""
@@ -141,6 +152,12 @@ class CompiledClearance:
                 self.offsets, self.hints, self.guesses, self.radii,
                 self.shape_joint, self.shape_rot, self.shape_p, self.capsule_a, self.capsule_b,
                 self.capsule_r, pairs)  # fmt: skip
+
+
+def _pair_rows(pairs: list[tuple[int, int, int]], index: dict) -> np.ndarray:
+    """(shape a, shape b, guess row, kind) rows of `pairs`."""
+    rows = [(a, b, index[a, b, kind], kind) for a, b, kind in pairs]
+    return np.array(rows, dtype=np.int64).reshape(-1, 4)
 
 
 def _core(shape: ConvexShape) -> tuple[np.ndarray, float] | None:
@@ -254,8 +271,9 @@ def _evaluate(
     neighbours, offsets, hints, guesses, radii, shape_joint, shape_rot, shape_p, capsule_a,
     capsule_b, capsule_r, pairs, static_min,
 ):  # fmt: skip
-    """Forward kinematics, shape poses, capsule lower bounds, then exact GJK in order of bound
-    until no bound is below the best distance found (the broad phase of Scene)."""
+    """(obstacle clearance, self clearance, end-effector position): forward kinematics, shape
+    poses, capsule lower bounds, then exact GJK in order of bound, skipping a pair whose bound
+    is not below the best distance of its kind (the broad phase of Scene)."""
     nj = parents.size
     oR = np.empty((nj, 3, 3))
     op = np.empty((nj, 3))
@@ -283,14 +301,31 @@ def _evaluate(
         a, b = pairs[k, 0], pairs[k, 1]
         gap = _segment_distance(ends[a, 0], ends[a, 1], ends[b, 0], ends[b, 1])
         lower[k] = gap - capsule_r[a] - capsule_r[b]
-    best = static_min
+    # Scalars, not a 2-array: this runs three times per BAORNN iteration.
+    best_obstacle, best_self = static_min[0], static_min[1]
+    has_obstacle = has_self = False  # a kind without pairs here cannot improve
+    for k in range(npairs):
+        if pairs[k, 3] == 0:
+            has_obstacle = True
+        else:
+            has_self = True
     for k in np.argsort(lower):
-        if lower[k] >= best:
-            break
+        limit = -np.inf
+        if has_obstacle:
+            limit = best_obstacle
+        if has_self and best_self > limit:
+            limit = best_self
+        if lower[k] >= limit:
+            break  # no later pair can lower either minimum
+        self_pair = pairs[k, 3] == 1
+        if lower[k] >= (best_self if self_pair else best_obstacle):
+            continue
         a, b = pairs[k, 0], pairs[k, 1]
         d = gjk_distance(vertices, neighbours, offsets, hints,
                          a, world_R[a], world_p[a], radii[a],
                          b, world_R[b], world_p[b], radii[b], guesses[pairs[k, 2]])  # fmt: skip
-        if d < best:
-            best = d
-    return best, ee
+        if self_pair and d < best_self:
+            best_self = d
+        elif not self_pair and d < best_obstacle:
+            best_obstacle = d
+    return best_obstacle, best_self, ee

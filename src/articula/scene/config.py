@@ -13,10 +13,11 @@ from articula.errors import ConfigError, GeometryError
 from articula.geometry.meshes import convex_parts, load_mesh
 from articula.geometry.poses import pose
 from articula.geometry.shapes import ConvexShape, box, capsule, cylinder, sphere
-from articula.limits import MAX_DECOMPOSE_VERTICES, MAX_LINKS, MAX_SCALE, MIN_SCALE
+from articula.limits import MAX_DECOMPOSE_VERTICES, MAX_LENGTH, MAX_LINKS, MAX_SCALE, MIN_SCALE
 from articula.robots.model import RobotModel
 from articula.scene.obstacles import Obstacle
 from articula.scene.scene import Metric, Scene
+from articula.scene.self_collision import MARGIN, SAMPLES, SelfCollisionMatrix, self_collision_matrix
 from articula.validation import (
     Point,
     PositiveLength,
@@ -53,6 +54,16 @@ class RobotSpec(StrictModel):
     locked_joints: dict[str, Radians] = Field(default_factory=dict)  # joint -> [rad or m]
     q0: list[Radians] | None = None
     max_links: Annotated[int, Field(ge=1, le=100_000)] = MAX_LINKS  # refuse larger URDFs
+    # Link-link distances count as clearance, for the pairs of scene/self_collision.py's
+    # allowed-collision matrix; allow_pairs are never checked.
+    self_collision: bool = False
+    allow_pairs: list[Annotated[list[str], Field(min_length=2, max_length=2)]] = Field(
+        default_factory=list
+    )
+    self_collision_samples: Annotated[int, Field(ge=1, le=100_000)] = SAMPLES
+    self_collision_margin: Annotated[float, Field(ge=0, le=MAX_LENGTH, allow_inf_nan=False)] = (
+        MARGIN  # [m]
+    )
 
     @model_validator(mode="after")
     def _one_source(self) -> RobotSpec:
@@ -129,7 +140,18 @@ def build_scene(
             obstacles.append(_obstacle(o, i, base_dir))
         except GeometryError as exc:
             raise ConfigError(f"obstacles[{i}] ({o.name or f'obstacle_{i}'})", str(exc)) from None
-    return Scene(robot, obstacles, broadphase=broadphase, metric=metric), q0
+    self_pairs = robot_self_collision(spec, robot).checked if r.self_collision else ()
+    return Scene(robot, obstacles, broadphase, metric, self_pairs), q0
+
+
+def robot_self_collision(spec: SceneSpec, robot: RobotModel) -> SelfCollisionMatrix:
+    """The allowed-collision matrix a scene file's [robot] table asks for (whether or not
+    self_collision is on); errors name the [robot] key."""
+    r = spec.robot
+    with fields_as({"allow_pairs": "robot.allow_pairs"}):
+        return self_collision_matrix(
+            robot, r.allow_pairs, r.self_collision_samples, r.self_collision_margin
+        )
 
 
 def _obstacle(spec: ObstacleSpec, index: int, base_dir: Path) -> Obstacle:

@@ -1,8 +1,9 @@
-"""Scene: a robot among obstacles, with signed link-obstacle distances (GJK/EPA via coal).
+"""Scene: a robot among obstacles, with signed link-obstacle distances (GJK/EPA via coal) and,
+for the link pairs it is given, link-link (self) distances.
 
 Robot link shapes and obstacle parts live in one Pinocchio GeometryModel, one collision pair
-per (link shape, obstacle part), so forward kinematics, placements and every exact distance
-run in C++. A second model holds a bounding capsule per shape: capsule-capsule distances
+per (link shape, obstacle part) and per (shape, shape) of a checked link pair, so forward
+kinematics, placements and every exact distance run in C++. A second model holds a bounding capsule per shape: capsule-capsule distances
 (closed form in coal) are lower bounds of the exact ones, which lets the broad phase skip
 pairs that cannot be the minimum.
 """
@@ -38,6 +39,16 @@ class Witnesses:
     on_obstacle: np.ndarray  # (links, obstacles, 3)
 
 
+@dataclass(frozen=True)
+class SelfWitnesses:
+    """Signed distance [m] of every checked link pair (a, b) and the closest points [m, world]
+    on link a and on link b."""
+
+    distance: np.ndarray  # (pairs,)
+    on_a: np.ndarray  # (pairs, 3)
+    on_b: np.ndarray  # (pairs, 3)
+
+
 class _Geometry:
     """The exact and bounding-capsule geometry models with matching objects and pairs."""
 
@@ -69,6 +80,9 @@ class Scene:
     metric "gjk" (default): signed distance between convex shapes, negative penetration depth
     when they overlap. metric "vertex": the book's Sect. 1.3.3 formula, the distance between
     the closest pair of vertices, which over-states clearance (docs/deviations.md).
+
+    self_pairs: the link pairs (by name) whose distance counts as clearance too, usually
+    scene.self_collision.checked_pairs (every pair that is not adjacent and can come close).
     """
 
     def __init__(
@@ -77,6 +91,7 @@ class Scene:
         obstacles: Sequence[Obstacle],
         broadphase: bool = True,
         metric: Metric = "gjk",
+        self_pairs: Sequence[tuple[str, str]] = (),
     ) -> None:
         if metric not in ("gjk", "vertex"):
             raise ConfigError("metric", f"unknown metric {metric!r}; choose 'gjk' or 'vertex'")
@@ -88,6 +103,7 @@ class Scene:
         self.broadphase = broadphase
         self.metric: Metric = metric
         self.link_names = [link.name for link in robot.links]
+        self.self_pairs = _link_pairs(self_pairs, self.link_names)
         geo = _Geometry()
         link_geoms = []
         for li, link in enumerate(robot.links):
@@ -114,8 +130,21 @@ class Scene:
                     cells.append((li, oi))
                     fixed = geo.exact.geometryObjects[g_link].parentJoint == 0
                     static.append(fixed and not self.obstacles[oi].moving)
+        self._n_obstacle_pairs = len(cells)
+        # Self pairs follow, one per (shape of a, shape of b); their cell is (-1, pair index).
+        self_cells = []
+        for k, (a, b) in enumerate(self.self_pairs):
+            for g_a, la in link_geoms:
+                for g_b, lb in link_geoms:
+                    if (la, lb) == (a, b):
+                        geo.pair(g_a, g_b)
+                        cells.append((-1, k))
+                        self_cells.append(k)
+                        joints = {geo.exact.geometryObjects[g].parentJoint for g in (g_a, g_b)}
+                        static.append(joints == {0})
         self._geo = geo
-        self._cells = np.array(cells, dtype=np.int64).reshape(-1, 2)
+        self._cells = np.array(cells[: self._n_obstacle_pairs], dtype=np.int64).reshape(-1, 2)
+        self._self_cells = np.array(self_cells, dtype=np.int64)
         self._exact_data = pin.GeometryData(geo.exact)
         self._bounds_data = pin.GeometryData(geo.bounds)
         # Element proxies made once: reading through them is several times cheaper.
@@ -124,20 +153,33 @@ class Scene:
         self._bound_results = list(self._bounds_data.distanceResults)
         for request in self._requests:
             request.enable_signed_distance = True  # EPA penetration depth when overlapping
-        self._cell_of_pair = [(int(li), int(oi)) for li, oi in self._cells]
+        self._cell_of_pair = cells
         self._trees = [cKDTree(s.vertices) for s in geo.shapes]
         self._moving = [oi for oi, o in enumerate(self.obstacles) if o.moving]
         self._shape = (len(robot.links), len(self.obstacles))
         # The broad phase computes static pairs once and leaves them out of every query.
         self._place(np.zeros(robot.nq), 0.0)
-        self._static_min = min(
-            (self._exact(p) for p, fixed in enumerate(static) if fixed), default=np.inf
-        )
+        kind_of = [int(p >= self._n_obstacle_pairs) for p in range(len(static))]  # 1: self
+        self._static_min = [np.inf, np.inf]
+        for p, fixed in enumerate(static):
+            if fixed:
+                self._static_min[kind_of[p]] = min(self._static_min[kind_of[p]], self._exact(p))
         self._dynamic = [p for p, fixed in enumerate(static) if not fixed]
+        self._dynamic_kinds = [kind_of[p] for p in self._dynamic]
         self._dynamic_bounds = [self._bound_results[p] for p in self._dynamic]
         for p, fixed in enumerate(static):
             if fixed:
                 self._bounds_data.deactivateCollisionPair(p)
+
+    @property
+    def self_pair_names(self) -> list[tuple[str, str]]:
+        """The checked link pairs by name, in the order of self_distances."""
+        return [(self.link_names[a], self.link_names[b]) for a, b in self.self_pairs]
+
+    @property
+    def has_clearance(self) -> bool:
+        """Whether any distance is checked: an obstacle, or a link pair for self-collision."""
+        return bool(self.obstacles or self.self_pairs)
 
     # ----- queries -----------------------------------------------------------------------------
 
@@ -151,7 +193,7 @@ class Scene:
         on_link = np.full((*self._shape, 3), np.nan)
         on_obstacle = np.full((*self._shape, 3), np.nan)
         best = np.full(self._shape, np.inf)
-        for p, (li, oi) in enumerate(self._cell_of_pair):
+        for p, (li, oi) in enumerate(self._cell_of_pair[: self._n_obstacle_pairs]):
             if d[p] < best[li, oi]:
                 best[li, oi] = d[p]
                 if self.metric == "gjk":
@@ -161,12 +203,45 @@ class Scene:
                     on_link[li, oi], on_obstacle[li, oi] = self._vertex_pair(p)
         return Witnesses(best, on_link, on_obstacle)
 
+    def self_distances(self, q: Sequence[float] | np.ndarray) -> np.ndarray:
+        """Signed distance [m] of every link pair in `self_pairs`, in its order."""
+        d = self._pair_distances(self.robot.check_q(q), 0.0, every_pair=True)
+        return self._self_minima(d)
+
+    def self_witnesses(self, q: Sequence[float] | np.ndarray) -> SelfWitnesses:
+        """Self distances with the closest point on each link of each pair."""
+        d = self._pair_distances(self.robot.check_q(q), 0.0, every_pair=True)
+        n = len(self.self_pairs)
+        best, on_a, on_b = np.full(n, np.inf), np.full((n, 3), np.nan), np.full((n, 3), np.nan)
+        for p in range(self._n_obstacle_pairs, len(d)):
+            k = self._cell_of_pair[p][1]
+            if d[p] < best[k]:
+                best[k] = d[p]
+                if self.metric == "gjk":
+                    on_a[k] = self._results[p].getNearestPoint1()
+                    on_b[k] = self._results[p].getNearestPoint2()
+                else:
+                    on_a[k], on_b[k] = self._vertex_pair(p)
+        return SelfWitnesses(best, on_a, on_b)
+
+    def self_clearance(self, q: Sequence[float] | np.ndarray) -> float:
+        """Smallest signed distance [m] between two links of a checked pair (inf without any)."""
+        return float(np.min(self.self_distances(q), initial=np.inf))
+
     def min_distance(self, q: Sequence[float] | np.ndarray, t: float = 0.0) -> float:
-        """Smallest signed distance [m] between any link and any obstacle."""
+        """Smallest signed distance [m] between any link and any obstacle, or between the two
+        links of a checked self pair."""
+        return min(self.clearances(q, t))
+
+    def clearances(self, q: Sequence[float] | np.ndarray, t: float = 0.0) -> tuple[float, float]:
+        """(smallest link-obstacle distance, smallest distance of a checked link pair) [m];
+        +inf for a kind without pairs."""
         q = self.robot.check_q(q)
         if self.broadphase and self.metric == "gjk":
             return self._min_broadphase(q, t)
-        return float(np.min(self._pair_distances(q, t, every_pair=True)))
+        d = self._pair_distances(q, t, every_pair=True)
+        n = self._n_obstacle_pairs
+        return float(np.min(d[:n], initial=np.inf)), float(np.min(d[n:], initial=np.inf))
 
     def distances_batch(self, Q: np.ndarray, t: float = 0.0) -> np.ndarray:
         """distances() for each row of Q: an array (configurations, links, obstacles)."""
@@ -247,7 +322,7 @@ class Scene:
             lower[p] = r.min_distance
         return lower
 
-    def _min_broadphase(self, q: np.ndarray, t: float) -> float:
+    def _min_broadphase(self, q: np.ndarray, t: float) -> tuple[float, float]:
         # The hot path of the planner: attribute lookups are hoisted, _exact is inlined.
         if self._moving:
             self._move_obstacles(t)
@@ -257,25 +332,36 @@ class Scene:
         exact_model, exact_data = self._geo.exact, self._exact_data
         pin.updateGeometryPlacements(model, data, exact_model, exact_data)
         requests, results, dynamic = self._requests, self._results, self._dynamic
-        best = self._static_min
+        best = list(self._static_min)  # [obstacles, self]
+        kinds = self._dynamic_kinds
+        present = [kind in kinds for kind in (0, 1)]
         # Visit pairs by increasing lower bound; none after the first bound above the best
-        # exact distance so far can be the minimum.
+        # exact distance so far of every kind can lower a minimum.
         for i in sorted(range(len(lower)), key=lower.__getitem__):
-            if lower[i] >= best:
-                break
+            kind = kinds[i]
+            if lower[i] >= best[kind]:
+                if all(lower[i] >= b for b, here in zip(best, present, strict=True) if here):
+                    break
+                continue
             p = dynamic[i]
             request = requests[p]
             request.cached_support_func_guess = _NO_SUPPORT_GUESS  # as in _exact
             request.cached_gjk_guess = _NO_GJK_GUESS
             pin.computeDistance(exact_model, exact_data, p)
             d = results[p].min_distance
-            if d < best:
-                best = d
-        return float(best)
+            if d < best[kind]:
+                best[kind] = d
+        return float(best[0]), float(best[1])
 
     def _cell_minima(self, pair_distances: list[float]) -> np.ndarray:
         out = np.full(self._shape, np.inf)
-        np.minimum.at(out, (self._cells[:, 0], self._cells[:, 1]), pair_distances)
+        obstacle_pairs = pair_distances[: self._n_obstacle_pairs]
+        np.minimum.at(out, (self._cells[:, 0], self._cells[:, 1]), obstacle_pairs)
+        return out
+
+    def _self_minima(self, pair_distances: list[float]) -> np.ndarray:
+        out = np.full(len(self.self_pairs), np.inf)
+        np.minimum.at(out, self._self_cells, pair_distances[self._n_obstacle_pairs :])
         return out
 
     def _vertex_pair(self, p: int) -> tuple[np.ndarray, np.ndarray]:
@@ -295,3 +381,18 @@ class Scene:
     def _vertex_distance(self, p: int) -> float:
         on_a, on_b = self._vertex_pair(p)
         return float(np.linalg.norm(on_a - on_b))
+
+
+def _link_pairs(pairs: Sequence[tuple[str, str]], links: list[str]) -> tuple[tuple[int, int], ...]:
+    """Link pairs by name as sorted index pairs, each once; ConfigError for an unknown link."""
+    out = set()
+    for a, b in pairs:
+        for name in (a, b):
+            if name not in links:
+                raise ConfigError("self_pairs", f"no link {name!r} with collision shapes; "
+                                  f"the links are {links}")  # fmt: skip
+        if a == b:
+            raise ConfigError("self_pairs", f"a link cannot collide with itself ({a!r})")
+        ia, ib = sorted((links.index(a), links.index(b)))
+        out.add((ia, ib))
+    return tuple(sorted(out))
