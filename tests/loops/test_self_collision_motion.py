@@ -47,6 +47,6 @@ def test_a_start_folded_into_itself_is_refused():
     robot = {"builtin": "iiwa14", "self_collision": True}
     scene, _ = build_scene(load_scene_spec({"robot": robot}), Path("."))
     controller = OnlineController.from_spec(scene, PlannerSpec(method="qp"))
-    with pytest.raises(InfeasibleError, match="q0.*collides with itself: links iiwa_link_5 and "
+    with pytest.raises(InfeasibleError, match=r"q0.*collides with itself: links iiwa_link_5 and "
                        "iiwa_link_7"):  # fmt: skip
         controller.reset(np.array([0.0, 1.9, 0.0, 2.0, 0.0, 2.0, 0.0]))

@@ -23,8 +23,9 @@ def test_mesh_scene_agrees_with_coal_including_overlaps():
     rng = np.random.default_rng(7)
     overlaps = 0
     for q in rng.uniform(ROBOT.lower, ROBOT.upper, (400, ROBOT.nq)):
-        d, d_self, ee = compiled.evaluate(q)
+        d, d_self, ee, ee_R = compiled.evaluate(q)
         assert d_self == np.inf  # no self pairs in this scene
+        assert np.allclose(ee_R, ROBOT.ee_pose(q)[:3, :3], atol=1e-12)
         reference = scene.min_distance(q)
         overlaps += reference <= 0
         # coal's GJK stops at its own tolerance; overlaps are clearance 0 here.
@@ -73,7 +74,7 @@ def test_self_pairs_agree_with_coal_and_stay_apart_from_obstacles():
     rng = np.random.default_rng(11)
     touching = 0
     for q in rng.uniform(ROBOT.lower, ROBOT.upper, (300, ROBOT.nq)):
-        d, d_self, _ = compiled.evaluate(q)
+        d, d_self, _, _ = compiled.evaluate(q)
         obstacles, itself = scene.clearances(q)
         assert itself == pytest.approx(scene.self_distances(q).min(), abs=1e-12)
         touching += itself <= 0

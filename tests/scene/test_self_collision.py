@@ -3,6 +3,8 @@ distances, against a brute-force hull-distance QP on random configurations."""
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 import qpsolvers
@@ -67,7 +69,7 @@ def test_self_distances_match_a_brute_force_hull_distance_on_random_configuratio
 
 def test_matrix_skips_adjacent_links_and_pairs_that_never_come_close():
     matrix = self_collision_matrix(ROBOT)
-    for a, b in zip(LINKS, LINKS[1:], strict=False):
+    for a, b in itertools.pairwise(LINKS):
         assert matrix.skipped[a, b] == "adjacent"
     # Over 1000 samples the shoulder links never come within 2 cm of link 3: skipped.
     assert matrix.skipped["iiwa_link_1", "iiwa_link_3"] == "never close"
@@ -102,11 +104,11 @@ def test_allowed_pairs_are_not_checked_and_bad_names_are_refused():
     matrix = self_collision_matrix(ROBOT, allow_pairs=[["iiwa_link_7", "iiwa_link_5"]])
     assert matrix.skipped["iiwa_link_5", "iiwa_link_7"] == "allowed"
     assert ("iiwa_link_5", "iiwa_link_7") not in matrix.checked
-    with pytest.raises(ConfigError, match="allow_pairs.*no link 'gripper'"):
+    with pytest.raises(ConfigError, match=r"allow_pairs.*no link 'gripper'"):
         self_collision_matrix(ROBOT, allow_pairs=[["gripper", "iiwa_link_5"]])
     with pytest.raises(ConfigError, match="itself"):
         self_collision_matrix(ROBOT, allow_pairs=[["iiwa_link_5", "iiwa_link_5"]])
-    with pytest.raises(ConfigError, match="self_pairs.*no link 'x'"):
+    with pytest.raises(ConfigError, match=r"self_pairs.*no link 'x'"):
         Scene(ROBOT, [], self_pairs=[("x", "iiwa_link_1")])
 
 

@@ -7,6 +7,7 @@ and a planned run share one code path:
     q = controller.reset(q_measured)
     every 10 ms:
         q = controller.step(target, {"box": pose_from_camera})   # send q to the arm
+    (target: a position [m], a 4×4 pose for a pose task, or a Target)
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import numpy as np
 from articula.errors import ConfigError, GeometryError, InfeasibleError
 from articula.planning.config import PlannerSpec, make_planner
 from articula.planning.planner import Planner
+from articula.planning.task import Target, unit
 from articula.scene.obstacles import Obstacle, check_pose
 from articula.scene.scene import Scene
 
@@ -52,6 +54,8 @@ class OnlineController:
         self.live = dict(live or {})
         self.periods = 0  # since reset; the time is periods · dt [s]
         self.q: np.ndarray | None = None
+        self.held: Target | None = None  # the start's orientation and tool axis
+        self.target: Target | None = None  # the last period's, complete
 
     @classmethod
     def from_spec(
@@ -99,16 +103,22 @@ class OnlineController:
                 )
         self.planner.reset()
         self.q, self.periods = start, 0
+        pose = robot.ee_pose(start)
+        self.held = Target(pose[:3, 3], pose[:3, :3], pose[:3, :3] @ self.planner.task.tool_axis)
         return start.copy()
 
     def step(
         self,
-        target: Sequence[float] | np.ndarray,
+        target: Sequence[float] | np.ndarray | Target,
         obstacle_poses: Mapping[str, np.ndarray] | None = None,
     ) -> np.ndarray:
-        """One control period toward the end-effector target [m]; obstacle_poses moves live
-        obstacles (name -> 4×4 pose in the world) first. Returns the new configuration [rad]."""
-        if self.q is None:
+        """One control period toward the target; obstacle_poses moves live obstacles (name ->
+        4×4 pose in the world) first. Returns the new configuration [rad].
+
+        The target is a position [m] (3 numbers), a pose (4×4, world) or a Target; an
+        orientation or axis the task needs and the target lacks is the start's, held.
+        """
+        if self.q is None or self.held is None:
             raise ConfigError("reset", "call reset(q) with the arm's configuration first")
         for name, pose in (obstacle_poses or {}).items():
             if name not in self.live:
@@ -118,12 +128,32 @@ class OnlineController:
                 self.live[name].pose = check_pose(name, np.asarray(pose, dtype=float))
             except GeometryError as exc:
                 raise ConfigError(f"obstacle_poses.{name}", str(exc)) from None
-        x_ref = np.asarray(target, dtype=float)
-        if x_ref.shape != (3,) or not np.all(np.isfinite(x_ref)):
-            raise ConfigError("target", f"needs 3 finite coordinates [m] (got {x_ref.tolist()})")
-        self.q = self.planner.step(self.q, x_ref, self.t)
+        self.target = self._complete(target)
+        self.q = self.planner.step(self.q, self.target, self.t)
         self.periods += 1
         return self.q.copy()
+
+    def _complete(self, target: Sequence[float] | np.ndarray | Target) -> Target:
+        """The target as a checked Target, with the held orientation and axis filled in."""
+        if not isinstance(target, Target):
+            arr = np.asarray(target, dtype=float)
+            if arr.shape == (4, 4):
+                R = arr[:3, :3]
+                if not (np.all(np.isfinite(arr)) and np.allclose(R @ R.T, np.eye(3), atol=1e-6)
+                        and np.linalg.det(R) > 0):  # fmt: skip
+                    raise ConfigError("target", "a 4×4 pose needs a finite rotation and position")
+                target = Target(arr[:3, 3].copy(), R.copy())
+            else:
+                target = Target(arr)
+        position = np.asarray(target.position, dtype=float)
+        if position.shape != (3,) or not np.all(np.isfinite(position)):
+            raise ConfigError(
+                "target", f"needs 3 finite coordinates [m] or a 4×4 pose (got {position.tolist()})"
+            )
+        held = self.held
+        rotation = held.rotation if target.rotation is None else target.rotation
+        axis = held.axis if target.axis is None else unit(target.axis, "target.axis")
+        return Target(position, rotation, axis)
 
     @property
     def t(self) -> float:

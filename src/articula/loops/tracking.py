@@ -12,9 +12,10 @@ from articula.errors import ConfigError
 from articula.limits import MAX_STEPS
 from articula.loops.online import OnlineController
 from articula.planning.planner import Planner
+from articula.planning.task import Target
 from articula.robots.model import RobotModel
 
-Trajectory = Callable[[float], np.ndarray]
+Trajectory = Callable[[float], "np.ndarray | Target"]  # a position [m] or a whole Target
 
 
 @dataclass(frozen=True)
@@ -30,6 +31,7 @@ class PlanResult:
     clearance: np.ndarray
     planner_seconds: float  # time spent in planner.step alone [s], not in the recording
     q0: np.ndarray | None = None  # the start [rad]; None: the first step's speed is unknown
+    orientation_error: np.ndarray | None = None  # [rad] for a pose or axis task, else None
 
 
 def track(
@@ -66,35 +68,50 @@ def track(
     x = np.empty((steps, 3))
     x_ref = np.empty((steps, 3))
     clearance = np.full(steps, np.inf)
+    task = planner.task
+    orientation = np.zeros(steps) if task.kind != "position" else None
     planner_seconds = 0.0
     every = max(1, steps // 100)
     for n, tn in enumerate(t):
         if progress is not None and n % every == 0:
             progress(n, steps)
-        x_ref[n] = trajectory(tn)
+        target = trajectory(tn)
         start = time.perf_counter()
-        q = controller.step(x_ref[n])
+        q = controller.step(target)
         planner_seconds += time.perf_counter() - start
         qs[n] = q
-        x[n] = robot.ee_position(q)
+        pose = robot.ee_pose(q)
+        x[n] = pose[:3, 3]
+        x_ref[n] = controller.target.position
+        if orientation is not None:
+            orientation[n] = task.orientation_error(pose[:3, :3], controller.target)
         if scene.has_clearance:
             clearance[n] = scene.min_distance(q, tn)
     error = np.linalg.norm(x - x_ref, axis=1)
-    return PlanResult(t, qs, x, x_ref, error, clearance, planner_seconds, q_start)
+    return PlanResult(t, qs, x, x_ref, error, clearance, planner_seconds, q_start, orientation)
 
 
 def tracking_metrics(
-    run: PlanResult, robot: RobotModel, settle: float, iterations: float
+    run: PlanResult, robot: RobotModel, settle: float, iterations: float, cone: float | None = None
 ) -> dict[str, float]:
     """Metrics of a tracking run.
 
     rms_error and max_error [m] after `settle` [s]; clearance [m] and colliding steps over the
     whole run and after `settle` (the approach from q0 is the riskiest part); joint-limit
     violations; planner time per inner iteration (`iterations` in all) and per period [µs].
+    For a pose or axis task also rms_ and max_orientation_error [rad] after `settle`, and with
+    a `cone` [rad] the settled steps whose tool axis is outside it (cone_violations).
     """
     settled = run.t >= settle
     late = run.error[settled]
     outside = (run.q < robot.lower) | (run.q > robot.upper)
+    extra = {}
+    if run.orientation_error is not None:
+        turned = run.orientation_error[settled]
+        extra["rms_orientation_error"] = float(np.sqrt(np.mean(turned**2)))
+        extra["max_orientation_error"] = float(turned.max())
+        if cone is not None:
+            extra["cone_violations"] = float(np.sum(turned > cone))
     return {
         "settle_s": settle,
         "rms_error": float(np.sqrt(np.mean(late**2))),
@@ -108,7 +125,7 @@ def tracking_metrics(
         # The planner alone: BAORNN's inner iterations, or a baseline's periods.
         "time_per_iteration_us": 1e6 * run.planner_seconds / max(iterations, 1.0),
         "time_per_period_us": 1e6 * run.planner_seconds / len(run.t),
-    }
+    } | extra
 
 
 def max_speed_ratio(run: PlanResult, robot: RobotModel) -> float:
@@ -123,10 +140,13 @@ def max_speed_ratio(run: PlanResult, robot: RobotModel) -> float:
 
 
 def trace_columns(run: PlanResult) -> dict[str, np.ndarray]:
-    """The run as trace columns: t, q_1..q_m, x, y, z, x_ref, y_ref, z_ref, error, clearance."""
+    """The run as trace columns: t, q_1..q_m, x, y, z, x_ref, y_ref, z_ref, error, clearance,
+    and orientation_error [rad] for a pose or axis task."""
     columns = {"t": run.t}
     columns.update({f"q_{j + 1}": run.q[:, j] for j in range(run.q.shape[1])})
     columns.update({"x": run.x[:, 0], "y": run.x[:, 1], "z": run.x[:, 2]})
     columns.update({"x_ref": run.x_ref[:, 0], "y_ref": run.x_ref[:, 1], "z_ref": run.x_ref[:, 2]})
     columns.update({"error": run.error, "clearance": run.clearance})
+    if run.orientation_error is not None:
+        columns["orientation_error"] = run.orientation_error
     return columns

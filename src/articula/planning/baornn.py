@@ -12,6 +12,7 @@ from pydantic import Field
 from articula.planning import baornn_kernel as kernel
 from articula.planning.objective import Box, Objective
 from articula.planning.rate_limits import RateLimits
+from articula.planning.task import Target, Task, as_target
 from articula.scene.scene import Scene
 from articula.validation import Positive, StrictModel
 
@@ -70,48 +71,57 @@ class BeetleSearch:
         """The hard clearance [m] of the objective (Eq. 1.12)."""
         return self.objective.d_min
 
+    @property
+    def task(self) -> Task:
+        """The task of the objective."""
+        return self.objective.task
+
 
 class Baornn(BeetleSearch):
     """The faithful algorithm of Sect. 1.3.1; all randomness from the injected generator."""
 
     def iterate(
-        self, q: np.ndarray, g: float, x_ref: np.ndarray, t: float
+        self, q: np.ndarray, g: float, target: Target | np.ndarray, t: float
     ) -> tuple[np.ndarray, float]:
         """One iteration of Algorithm 1 from (q, g = g(q)); returns the accepted (q, g)."""
+        target = as_target(target)
         obj = self.objective
         b = self.rng.standard_normal(q.size)
         if obj.compiled is not None:
             self.evaluations += 3
             self.iterations += 1
-            return kernel.iterations(q, g, x_ref, b[None, :], self.params.c1, self.params.c2,
+            return kernel.iterations(q, g, target.position, obj.orient_arguments(target),
+                                     b[None, :], self.params.c1, self.params.c2,
                                      *obj.kernel_arguments(self._box))  # fmt: skip
         b /= math.sqrt(b @ b)  # a normalised random direction
         lam = self.params.c1 * np.sqrt(g) if np.isfinite(g) else self.params.c1  # Eq. (1.23)
         # Eqs. (1.15)-(1.18): antennae, projected onto Ω, evaluated by "virtual robots".
-        _, g_left = obj.project_and_value(q + lam * b, q, g, x_ref, t, self._box)
-        _, g_right = obj.project_and_value(q - lam * b, q, g, x_ref, t, self._box)
+        _, g_left = obj.project_and_value(q + lam * b, q, g, target, t, self._box)
+        _, g_right = obj.project_and_value(q - lam * b, q, g, target, t, self._box)
         delta = self.params.c2 * lam  # Eq. (1.24)
         step = q - delta * np.sign(g_left - g_right) * b  # Eq. (1.19)
-        q_new, g_new = obj.project_and_value(step, q, g, x_ref, t, self._box)  # Eq. (1.20)
+        q_new, g_new = obj.project_and_value(step, q, g, target, t, self._box)  # Eq. (1.20)
         self.evaluations += 3
         self.iterations += 1
         if g_new < g:  # Eqs. (1.21)-(1.22): accept only an improvement
             return q_new, g_new
         return q, g
 
-    def step(self, q: np.ndarray, x_ref: np.ndarray, t: float) -> np.ndarray:
-        """One control period: re-evaluate g for the new reference, then iterate."""
+    def step(self, q: np.ndarray, target: Target | np.ndarray, t: float) -> np.ndarray:
+        """One control period: re-evaluate g for the new target, then iterate."""
+        target = as_target(target)
         obj, k, start = self.objective, self.params.iterations_per_step, q
         self._begin_period(q)
-        g = obj.value(q, x_ref, t)
+        g = obj.value(q, target, t)
         if obj.compiled is not None:
             # The same draws as k calls of iterate: the Generator fills rows in order.
             directions = self.rng.standard_normal((k, q.size))
             self.evaluations += 3 * k
             self.iterations += k
-            q, _ = kernel.iterations(q, g, x_ref, directions, self.params.c1, self.params.c2,
+            q, _ = kernel.iterations(q, g, target.position, obj.orient_arguments(target),
+                                     directions, self.params.c1, self.params.c2,
                                      *obj.kernel_arguments(self._box))  # fmt: skip
             return self._end_period(start, q)
         for _ in range(k):
-            q, g = self.iterate(q, g, x_ref, t)
+            q, g = self.iterate(q, g, target, t)
         return self._end_period(start, q)

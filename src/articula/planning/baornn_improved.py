@@ -21,6 +21,7 @@ from pydantic import Field
 
 from articula.planning import baornn_kernel as kernel
 from articula.planning.baornn import BaornnParams, BeetleSearch
+from articula.planning.task import Target, as_target
 
 
 class ImprovedParams(BaornnParams):
@@ -38,21 +39,23 @@ class ImprovedBaornn(BeetleSearch):
     _last_motion: np.ndarray | None = field(default=None, init=False)
 
     def iterate(
-        self, q: np.ndarray, g: float, x_ref: np.ndarray, t: float
+        self, q: np.ndarray, g: float, target: Target | np.ndarray, t: float
     ) -> tuple[np.ndarray, float]:
         """One iteration from (q, g = g(q)); returns the accepted (q, g)."""
+        target = as_target(target)
         obj, p = self.objective, self.params
         draw = self.rng.standard_normal((q.size, min(p.pairs, q.size)))
         if obj.compiled is not None:
-            return self._compiled(q, g, x_ref, draw[None])
-        lam = p.c1 * math.sqrt(obj.tracking_error(q, x_ref))
+            return self._compiled(q, g, target, draw[None])
+        lam = p.c1 * math.sqrt(obj.tracking_error(q, target))
         # Orthonormal directions: QR of a Gaussian matrix (columns), as many as pairs.
         directions, _ = np.linalg.qr(draw)
         gradient = np.zeros(q.size)
         best_q, best_g = q, g
         for b in directions.T:
-            q_left, g_left = obj.project_and_value(q + lam * b, q, g, x_ref, t, self._box)  # (1.15)
-            q_right, g_right = obj.project_and_value(q - lam * b, q, g, x_ref, t, self._box)
+            # Eq. (1.15): the two antennae.
+            q_left, g_left = obj.project_and_value(q + lam * b, q, g, target, t, self._box)
+            q_right, g_right = obj.project_and_value(q - lam * b, q, g, target, t, self._box)
             if np.isfinite(g_left) and np.isfinite(g_right):
                 gradient += (g_left - g_right) * b
             for q_a, g_a in ((q_left, g_left), (q_right, g_right)):
@@ -62,7 +65,7 @@ class ImprovedBaornn(BeetleSearch):
         self.evaluations += 2 * directions.shape[1]
         if norm > 0:
             step = q - p.c2 * lam * gradient / norm  # Eq. (1.19) along the estimated gradient
-            q_new, g_new = obj.project_and_value(step, q, g, x_ref, t, self._box)
+            q_new, g_new = obj.project_and_value(step, q, g, target, t, self._box)
             self.evaluations += 1
             if g_new < best_g:  # Eqs. (1.21)-(1.22): only an improvement is accepted
                 best_q, best_g = q_new, g_new
@@ -74,14 +77,15 @@ class ImprovedBaornn(BeetleSearch):
         super().reset()
         self._last_motion = None
 
-    def step(self, q: np.ndarray, x_ref: np.ndarray, t: float) -> np.ndarray:
+    def step(self, q: np.ndarray, target: Target | np.ndarray, t: float) -> np.ndarray:
         """One control period: warm start, then iterate."""
+        target = as_target(target)
         start = q
         self._begin_period(q)
-        g = self.objective.value(q, x_ref, t)
+        g = self.objective.value(q, target, t)
         if self._last_motion is not None:
             warm = q + self._last_motion
-            q_warm, g_warm = self.objective.project_and_value(warm, q, g, x_ref, t, self._box)
+            q_warm, g_warm = self.objective.project_and_value(warm, q, g, target, t, self._box)
             self.evaluations += 1
             if g_warm < g:
                 q, g = q_warm, g_warm
@@ -89,15 +93,15 @@ class ImprovedBaornn(BeetleSearch):
         if self.objective.compiled is not None:
             # The same draws as iterations_per_step calls of iterate, in one compiled call.
             draws = self.rng.standard_normal((p.iterations_per_step, q.size, min(p.pairs, q.size)))
-            q, g = self._compiled(q, g, x_ref, draws)
+            q, g = self._compiled(q, g, target, draws)
         else:
             for _ in range(p.iterations_per_step):
-                q, g = self.iterate(q, g, x_ref, t)
+                q, g = self.iterate(q, g, target, t)
         self._last_motion = q - start
         return self._end_period(start, q)
 
     def _compiled(
-        self, q: np.ndarray, g: float, x_ref: np.ndarray, draws: np.ndarray
+        self, q: np.ndarray, g: float, target: Target, draws: np.ndarray
     ) -> tuple[np.ndarray, float]:
         """The iterations of `draws` by planning/baornn_kernel.py."""
         obj, p = self.objective, self.params
@@ -105,8 +109,9 @@ class ImprovedBaornn(BeetleSearch):
             self._box
         )
         q, g, evaluations = kernel.improved_iterations(
-            q, g, x_ref, draws, p.c1, p.c2, lambda_weight, beta, d_min, lower, upper, arrays,
-            obj.kinematics_arguments(), static_min,
+            q, g, target.position, obj.orient_arguments(target), draws, p.c1, p.c2,
+            lambda_weight, beta, d_min, lower, upper, arrays, obj.kinematics_arguments(),
+            static_min,
         )  # fmt: skip
         self.evaluations += evaluations
         self.iterations += draws.shape[0]

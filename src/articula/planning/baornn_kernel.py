@@ -11,12 +11,25 @@ import math
 import numpy as np
 
 from articula.numba_cache import jit
+from articula.planning.task import orientation_error
 from articula.scene.compiled_clearance import _evaluate
 
 
 @jit()
+def _task_error(ee, ee_R, x_ref, orient):  # fmt: skip
+    """||x_r − f(θ)|| (Eq. 1.5), plus weight · orientation error for a pose or axis task;
+    orient = (task code, weight, tool axis, reference rotation, reference axis)."""
+    ex, ey, ez = x_ref[0] - ee[0], x_ref[1] - ee[1], x_ref[2] - ee[2]
+    e = math.sqrt(ex * ex + ey * ey + ez * ez)
+    kind, weight, tool_axis, R_ref, axis_ref = orient
+    if kind != 0:
+        e += weight * orientation_error(kind, tool_axis, ee_R, R_ref, axis_ref)
+    return e
+
+
+@jit()
 def _project_and_value(
-    q, q_current, g_current, x_ref, lambda_weight, beta, d_min, lower, upper, arrays,
+    q, q_current, g_current, x_ref, orient, lambda_weight, beta, d_min, lower, upper, arrays,
     static_min,
 ):  # fmt: skip
     """(P_Ω(q), g there), Eqs. (1.17)-(1.18); stays at (q_current, g_current) unless the
@@ -24,11 +37,10 @@ def _project_and_value(
     d_min = 0 still rejects a point inside an obstacle. The pairs in `arrays` are the ones
     that count (an obstacle clearance of +inf: none)."""
     clipped = np.minimum(np.maximum(q, lower), upper)
-    d, d_self, ee = _evaluate(clipped, *arrays, static_min)
+    d, d_self, ee, ee_R = _evaluate(clipped, *arrays, static_min)
     if d <= d_min or d_self <= 0.0:
         return q_current, g_current
-    ex, ey, ez = x_ref[0] - ee[0], x_ref[1] - ee[1], x_ref[2] - ee[2]
-    g = math.sqrt(ex * ex + ey * ey + ez * ez)  # Eq. (1.5)
+    g = _task_error(ee, ee_R, x_ref, orient)  # Eq. (1.5), with the orientation term
     if lambda_weight > 0.0 and d < np.inf:
         g += lambda_weight / d**beta if d > 0.0 else np.inf  # Eq. (1.7)
     return clipped, g
@@ -36,7 +48,7 @@ def _project_and_value(
 
 @jit()
 def iterations(
-    q, g, x_ref, directions, c1, c2, lambda_weight, beta, d_min, lower, upper,
+    q, g, x_ref, orient, directions, c1, c2, lambda_weight, beta, d_min, lower, upper,
     arrays, static_min,
 ):  # fmt: skip
     """Run one iteration of Algorithm 1 per row of `directions` (raw Gaussian draws, normalised
@@ -44,16 +56,16 @@ def iterations(
     for k in range(directions.shape[0]):
         b = directions[k] / math.sqrt(directions[k] @ directions[k])
         lam = c1 * math.sqrt(g) if math.isfinite(g) else c1  # Eq. (1.23)
-        _, g_left = _project_and_value(q + lam * b, q, g, x_ref, lambda_weight, beta,
+        _, g_left = _project_and_value(q + lam * b, q, g, x_ref, orient, lambda_weight, beta,
                                             d_min, lower, upper, arrays,
                                             static_min)  # fmt: skip
-        _, g_right = _project_and_value(q - lam * b, q, g, x_ref, lambda_weight, beta,
+        _, g_right = _project_and_value(q - lam * b, q, g, x_ref, orient, lambda_weight, beta,
                                               d_min, lower, upper, arrays,
                                               static_min)  # fmt: skip
         diff = g_left - g_right
         sign = 1.0 if diff > 0.0 else (-1.0 if diff < 0.0 else 0.0)  # 0 when both are inf
         step = q - c2 * lam * sign * b  # Eqs. (1.19), (1.24)
-        q_new, g_new = _project_and_value(step, q, g, x_ref, lambda_weight, beta, d_min,
+        q_new, g_new = _project_and_value(step, q, g, x_ref, orient, lambda_weight, beta, d_min,
                                           lower, upper, arrays,
                                           static_min)  # fmt: skip
         if g_new < g:  # Eqs. (1.21)-(1.22)
@@ -63,7 +75,7 @@ def iterations(
 
 @jit()
 def improved_iterations(
-    q, g, x_ref, draws, c1, c2, lambda_weight, beta, d_min, lower, upper,
+    q, g, x_ref, orient, draws, c1, c2, lambda_weight, beta, d_min, lower, upper,
     arrays, kinematics, static_min,
 ):  # fmt: skip
     """baornn-improved's iterations (planning/baornn_improved.py), one per draws[k], an
@@ -72,18 +84,17 @@ def improved_iterations(
     n = q.size
     evaluations = 0
     for k in range(draws.shape[0]):
-        _, _, ee = _evaluate(q, *kinematics, static_min)
-        ex, ey, ez = x_ref[0] - ee[0], x_ref[1] - ee[1], x_ref[2] - ee[2]
-        lam = c1 * math.sqrt(math.sqrt(ex * ex + ey * ey + ez * ez))  # c1·√e_k
+        _, _, ee, ee_R = _evaluate(q, *kinematics, static_min)
+        lam = c1 * math.sqrt(_task_error(ee, ee_R, x_ref, orient))  # c1·√e_k
         directions, _ = np.linalg.qr(draws[k])
         gradient = np.zeros(n)
         best_q, best_g = q, g
         for j in range(directions.shape[1]):
             b = np.ascontiguousarray(directions[:, j])
-            q_left, g_left = _project_and_value(q + lam * b, q, g, x_ref, lambda_weight, beta,
-                                                d_min, lower, upper, arrays,
-                                                static_min)  # fmt: skip
-            q_right, g_right = _project_and_value(q - lam * b, q, g, x_ref, lambda_weight,
+            q_left, g_left = _project_and_value(q + lam * b, q, g, x_ref, orient,
+                                                lambda_weight, beta, d_min, lower, upper,
+                                                arrays, static_min)  # fmt: skip
+            q_right, g_right = _project_and_value(q - lam * b, q, g, x_ref, orient, lambda_weight,
                                                   beta, d_min, lower, upper,
                                                   arrays, static_min)  # fmt: skip
             evaluations += 2
@@ -96,7 +107,7 @@ def improved_iterations(
         norm = math.sqrt(gradient @ gradient)
         if norm > 0.0:
             step = q - c2 * lam * gradient / norm  # Eq. (1.19) along the estimated gradient
-            q_new, g_new = _project_and_value(step, q, g, x_ref, lambda_weight, beta, d_min,
+            q_new, g_new = _project_and_value(step, q, g, x_ref, orient, lambda_weight, beta, d_min,
                                               lower, upper, arrays,
                                               static_min)  # fmt: skip
             evaluations += 1

@@ -15,6 +15,14 @@ from articula.planning.objective import Objective
 from articula.planning.planner import Planner
 from articula.planning.qp_ik import QpIk, QpIkParams
 from articula.planning.rate_limits import RateLimits
+from articula.planning.target_path import (
+    TargetPath,
+    WaypointRotations,
+    axis_direction,
+    fixed_rotation,
+    rotation_from,
+)
+from articula.planning.task import Task, TaskKind
 from articula.planning.trajectories import Circle, Waypoints, rectangle
 from articula.planning.velocity_ik import VelocityIk, VelocityIkParams
 from articula.robots.model import RobotModel
@@ -26,6 +34,7 @@ from articula.validation import (
     Point,
     Positive,
     PositiveLength,
+    Radians,
     Seed,
     StrictModel,
     field_error,
@@ -33,6 +42,8 @@ from articula.validation import (
 )
 
 Method = Literal["baornn", "baornn-improved", "pinv", "dls", "qp"]
+Rpy = Annotated[list[Radians], Field(min_length=3, max_length=3)]
+Quaternion = Annotated[list[Finite], Field(min_length=4, max_length=4)]
 
 
 class TrajectorySpec(StrictModel):
@@ -48,6 +59,14 @@ class TrajectorySpec(StrictModel):
     points: list[Point] | None = None
     times: list[Finite] | None = None
     path: str | None = None
+    # The tool's orientation (pose task): fixed, or one per waypoint (interpolated by slerp).
+    rpy: Rpy | None = None  # [rad] roll, pitch, yaw about the world's x, y, z
+    quaternion: Quaternion | None = None  # [w, x, y, z]
+    rpys: list[Rpy] | None = None
+    quaternions: list[Quaternion] | None = None
+    # The tool axis's direction (position+axis task) and how far from it it may be [rad].
+    axis: Point | None = None
+    cone: Annotated[float, Field(gt=0, le=np.pi, allow_inf_nan=False)] | None = None
 
     @model_validator(mode="after")
     def _fields_of_type(self) -> TrajectorySpec:
@@ -60,6 +79,13 @@ class TrajectorySpec(StrictModel):
         missing = [k for k in needed if getattr(self, k) is None]
         if missing:
             raise ValueError(f"type = {self.type!r} needs {', '.join(missing)}")
+        given = [k for k in ("rpy", "quaternion", "rpys", "quaternions") if getattr(self, k)]
+        if len(given) > 1:
+            raise ValueError(f"give one orientation, not {' and '.join(given)}")
+        if (self.rpys or self.quaternions) and self.type != "waypoints":
+            raise ValueError("rpys and quaternions (one per point) need type = 'waypoints'")
+        if self.cone is not None and self.axis is None:
+            raise ValueError("cone needs an axis")
         return self
 
 
@@ -96,6 +122,11 @@ class PlannerSpec(StrictModel):
     limits: Literal["velocity", "none"] = "velocity"
     velocity_scale: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 1.0
     max_acceleration: Positive | None = None  # [rad/s²] for every joint; None: no limit
+    # What the end effector tracks (beyond the book's position): the trajectory's orientation
+    # or tool axis; without one given, the start's is held.
+    task: TaskKind = "position"
+    orientation_weight: NonNegative = 0.1  # [m/rad] BAORNN's weight on the orientation error
+    tool_axis: Point = Field(default_factory=lambda: [0.0, 0.0, 1.0])  # in the ee frame
 
     @model_validator(mode="after")
     def _times(self) -> PlannerSpec:
@@ -127,7 +158,8 @@ def make_planner(spec: PlannerSpec, scene: Scene, seed: int) -> Planner:
 def _planner(spec: PlannerSpec, scene: Scene, seed: int) -> Planner:
     """make_planner without the renaming of its errors."""
     rng = np.random.default_rng(seed)
-    objective = Objective(scene, spec.lambda_weight, spec.beta, spec.d_min)
+    task = Task(spec.task, spec.orientation_weight, np.asarray(spec.tool_axis))
+    objective = Objective(scene, spec.lambda_weight, spec.beta, spec.d_min, task=task)
     rate = rate_limits(spec, scene.robot)
     if spec.method == "baornn":
         params = BaornnParams(c1=spec.c1, c2=spec.c2, iterations_per_step=spec.iterations_per_step)
@@ -139,12 +171,12 @@ def _planner(spec: PlannerSpec, scene: Scene, seed: int) -> Planner:
     if spec.method == "qp":
         qp = QpIkParams(gain=spec.gain, influence=spec.influence, safety=spec.safety,
                         speed_scale=spec.velocity_scale)  # fmt: skip
-        return QpIk(scene, spec.dt, qp, spec.d_min)
+        return QpIk(scene, spec.dt, qp, spec.d_min, task)
     velocity = VelocityIkParams(
         gain=spec.gain, damping=spec.damping, repulsion=spec.repulsion, influence=spec.influence,
         speed_scale=spec.velocity_scale,
     )  # fmt: skip
-    return VelocityIk(scene, spec.method, spec.dt, velocity, spec.d_min)
+    return VelocityIk(scene, spec.method, spec.dt, velocity, spec.d_min, task)
 
 
 def rate_limits(spec: PlannerSpec, robot: RobotModel) -> RateLimits | None:
@@ -157,11 +189,15 @@ def rate_limits(spec: PlannerSpec, robot: RobotModel) -> RateLimits | None:
 
 
 # "QpIkParams.safety" -> "planner.safety": the library's names of the [planner] keys.
-PARAMETER_KEYS = {
-    f"{model.__name__}.{name}": f"planner.{name}"
-    for model in (BaornnParams, ImprovedParams, QpIkParams, VelocityIkParams)
-    for name in model.model_fields
-} | {f"Objective.{name}": f"planner.{name}" for name in ("lambda_weight", "beta", "d_min")}
+PARAMETER_KEYS = (
+    {
+        f"{model.__name__}.{name}": f"planner.{name}"
+        for model in (BaornnParams, ImprovedParams, QpIkParams, VelocityIkParams)
+        for name in model.model_fields
+    }
+    | {f"Objective.{name}": f"planner.{name}" for name in ("lambda_weight", "beta", "d_min")}
+    | {"orientation_weight": "planner.orientation_weight", "tool_axis": "planner.tool_axis"}
+)
 
 
 def make_trajectory(spec: TrajectorySpec, base_dir: Path) -> Circle | Waypoints:
@@ -169,6 +205,22 @@ def make_trajectory(spec: TrajectorySpec, base_dir: Path) -> Circle | Waypoints:
     Errors name the [trajectory] key at fault."""
     with fields_as({name: f"trajectory.{name}" for name in TrajectorySpec.model_fields}):
         return _trajectory(spec, base_dir)
+
+
+def make_targets(spec: TrajectorySpec, base_dir: Path) -> TargetPath:
+    """The targets a TrajectorySpec names: its path, and its orientation and axis if given."""
+    with fields_as({name: f"trajectory.{name}" for name in TrajectorySpec.model_fields}):
+        path = _trajectory(spec, base_dir)
+        rotations = None
+        if spec.rpy is not None or spec.quaternion is not None:
+            rotations = fixed_rotation(rotation_from(spec.rpy, spec.quaternion))
+        elif spec.rpys is not None or spec.quaternions is not None:
+            each = [rotation_from(r, None) for r in spec.rpys or []] + [
+                rotation_from(None, quaternion) for quaternion in spec.quaternions or []
+            ]
+            rotations = WaypointRotations.create(each, spec.times or [])
+        axis = None if spec.axis is None else axis_direction(spec.axis)
+        return TargetPath(path, rotations, axis, spec.cone)
 
 
 def _trajectory(spec: TrajectorySpec, base_dir: Path) -> Circle | Waypoints:

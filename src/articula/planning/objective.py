@@ -9,6 +9,7 @@ import numpy as np
 import pinocchio as pin
 
 from articula.errors import ConfigError, ModelError
+from articula.planning.task import Target, Task, as_target, target_arrays
 from articula.scene.compiled_clearance import CompiledClearance
 from articula.scene.scene import Scene
 
@@ -21,7 +22,8 @@ class Objective:
 
     lambda_weight is Λ, beta is β, d_min [m] the hard clearance of Eq. (1.12). With several
     obstacles, Eq. (1.14) takes the largest penalty, i.e. the smallest distance over all of
-    them, which is what Scene.min_distance returns.
+    them. Beyond the book, a pose or axis `task` adds w · (orientation error) [m] to the
+    tracking term (docs/deviations.md).
     """
 
     scene: Scene
@@ -29,6 +31,7 @@ class Objective:
     beta: float = 1.0
     d_min: float = 0.0
     use_compiled: bool = True
+    task: Task = field(default_factory=Task)
     # The compiled evaluation of the same objective, when allowed and the scene permits it
     # (static obstacles, revolute joints, no cylinders, GJK metric); None: Scene (Pinocchio +
     # coal) is used.
@@ -60,36 +63,44 @@ class Objective:
         then no link-obstacle distance is computed at all."""
         return bool(self.scene.obstacles) and (self.lambda_weight > 0 or self.d_min > 0)
 
+    def orient_arguments(self, target: Target) -> tuple:
+        """The task and the target's orientation as planning.baornn_kernel takes them."""
+        R_ref, axis_ref = target_arrays(self.task, target)
+        return (self.task.code, self.task.weight, self.task.tool_axis, R_ref, axis_ref)
+
     def kinematics_arguments(self) -> tuple:
         """The compiled scene arrays without any pair: forward kinematics only."""
         if self.compiled is None:
             raise ModelError("this scene has no compiled evaluation (see Objective.compiled)")
         return self.compiled.arrays(self.compiled.no_pairs)
 
-    def value(self, q: np.ndarray, x_ref: np.ndarray, t: float = 0.0) -> float:
-        """Objective g at configuration q [rad] for the reference point x_ref [m]."""
+    def value(self, q: np.ndarray, target: Target | np.ndarray, t: float = 0.0) -> float:
+        """Objective g at configuration q [rad] for the target (or a position [m])."""
+        target = as_target(target)
         if self.compiled is not None:
-            d, _, ee = self.compiled.evaluate(q, self.needs_obstacles, False)
-            return self._combine(x_ref - ee, d)
+            d, _, ee, ee_R = self.compiled.evaluate(q, self.needs_obstacles, False)
+            return self._combine(self._task_error(target, ee, ee_R), d)
         d = self.scene.clearances(q, t)[0] if self.needs_obstacles else np.inf
-        return self._value(q, x_ref, d)
+        return self._value(q, target, d)
 
-    def tracking_error(self, q: np.ndarray, x_ref: np.ndarray) -> float:
-        """The tracking term ||x_r − f(θ)|| [m] of g alone, Eq. (1.5)."""
+    def tracking_error(self, q: np.ndarray, target: Target | np.ndarray) -> float:
+        """The task term of g alone: ||x_r − f(θ)|| [m], Eq. (1.5), plus the weighted
+        orientation error of a pose or axis task."""
+        target = as_target(target)
         if self.compiled is not None:
-            e = x_ref - self.compiled.evaluate(q, False, False)[2]
-            return math.sqrt(e @ e)
+            _, _, ee, ee_R = self.compiled.evaluate(q, False, False)
+            return self._task_error(target, ee, ee_R)
         robot = self.scene.robot
         robot.forward(q)
-        e = x_ref - robot.data.oMf[robot.ee_frame_id].translation
-        return math.sqrt(e @ e)
+        placement = robot.data.oMf[robot.ee_frame_id]
+        return self._task_error(target, placement.translation, placement.rotation)
 
     def project_and_value(
         self,
         q: np.ndarray,
         q_current: np.ndarray,
         g_current: float,
-        x_ref: np.ndarray,
+        target: Target | np.ndarray,
         t: float,
         box: Box | None = None,
     ) -> tuple[np.ndarray, float]:
@@ -97,23 +108,24 @@ class Objective:
         (the joint limits narrowed by speed limits); if the clipped point is closer than d_min
         to an obstacle or touches itself (a checked link pair), stay at (q_current, g_current).
         One distance query serves both the constraints and the penalty."""
+        target = as_target(target)
         clipped = self.scene.robot.clip(q) if box is None else np.clip(q, *box)
         if self.compiled is not None:
-            d, d_self, ee = self.compiled.evaluate(clipped, self.needs_obstacles)
+            d, d_self, ee, ee_R = self.compiled.evaluate(clipped, self.needs_obstacles)
             if d <= self.d_min or d_self <= 0:  # Ω: d > d_min (1.12); 0 on overlap
                 return q_current, g_current
-            return clipped, self._combine(x_ref - ee, d)
+            return clipped, self._combine(self._task_error(target, ee, ee_R), d)
         if not (self.needs_obstacles or self.scene.self_pairs):
-            return clipped, self._value(clipped, x_ref, np.inf)
+            return clipped, self._value(clipped, target, np.inf)
         d, d_self = self.scene.clearances(clipped, t)  # also leaves the joint placements updated
         if not self.needs_obstacles:
             d = np.inf
         if d <= self.d_min or d_self <= 0:  # Ω is d > d_min (1.12), and clear of itself
             return q_current, g_current
-        return clipped, self._value(clipped, x_ref, d, kinematics_done=True)
+        return clipped, self._value(clipped, target, d, kinematics_done=True)
 
     def _value(
-        self, q: np.ndarray, x_ref: np.ndarray, d: float, kinematics_done: bool = False
+        self, q: np.ndarray, target: Target, d: float, kinematics_done: bool = False
     ) -> float:
         robot = self.scene.robot
         if kinematics_done:
@@ -121,11 +133,20 @@ class Objective:
             pin.updateFramePlacement(robot.model, robot.data, robot.ee_frame_id)
         else:
             robot.forward(q)
-        return self._combine(x_ref - robot.data.oMf[robot.ee_frame_id].translation, d)
+        placement = robot.data.oMf[robot.ee_frame_id]
+        return self._combine(self._task_error(target, placement.translation, placement.rotation), d)
 
-    def _combine(self, e: np.ndarray, d: float) -> float:
-        """g from the tracking error vector e [m] and the clearance d [m]."""
-        g = math.sqrt(e @ e)  # Eq. (1.5); np.linalg.norm costs more than the rest for 3 numbers
+    def _task_error(self, target: Target, ee: np.ndarray, ee_R: np.ndarray) -> float:
+        """||x_r − f(θ)|| [m] (Eq. 1.5), plus w · orientation error for a pose or axis task."""
+        e = target.position - ee
+        error = math.sqrt(e @ e)  # np.linalg.norm costs more than the rest for 3 numbers
+        if self.task.kind != "position":
+            error += self.task.weight * self.task.orientation_error(ee_R, target)
+        return error
+
+    def _combine(self, error: float, d: float) -> float:
+        """g from the task error [m] and the clearance d [m]."""
+        g = error
         if self.lambda_weight > 0 and d < np.inf:
             # Eq. (1.7): inside an obstacle the penalty has no finite value.
             g += self.lambda_weight / d**self.beta if d > 0 else np.inf

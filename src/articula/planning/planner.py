@@ -6,11 +6,12 @@ from typing import Protocol
 
 import numpy as np
 
+from articula.planning.task import Target, Task
 from articula.scene.scene import Scene
 
 
 class Planner(Protocol):
-    """One control period at a time: from q [rad] toward the reference point x_ref [m]."""
+    """One control period at a time: from q [rad] toward the target."""
 
     @property
     def scene(self) -> Scene:
@@ -23,11 +24,16 @@ class Planner(Protocol):
         ...
 
     @property
+    def task(self) -> Task:
+        """What the end effector tracks: position, pose or position and tool axis."""
+        ...
+
+    @property
     def iterations(self) -> int:
         """Inner iterations (BAORNN) or solver calls (baselines) done so far."""
         ...
 
-    def step(self, q: np.ndarray, x_ref: np.ndarray, t: float) -> np.ndarray:
+    def step(self, q: np.ndarray, target: Target, t: float) -> np.ndarray:
         """The configuration [rad] for time t [s]."""
         ...
 

@@ -1,5 +1,6 @@
 """Reactive QP baseline after Haviland & Corke's NEO: velocity dampers on link-obstacle
-distances (and checked link-link ones), joint limits, a slack on the end-effector velocity, solved every period."""
+distances (and checked link-link ones) and joint limits, a slack on each task row, solved
+every period."""
 
 from __future__ import annotations
 
@@ -10,7 +11,8 @@ import qpsolvers
 from pydantic import model_validator
 
 from articula.planning.clearance import clearance_rows
-from articula.planning.reference_velocity import RateParams, reference_velocity
+from articula.planning.reference_velocity import RateParams, task_rows
+from articula.planning.task import Target, Task, as_target
 from articula.scene.scene import Scene
 from articula.validation import NonNegative, field_error
 
@@ -55,31 +57,31 @@ class QpIk:
     dt: float
     params: QpIkParams = field(default_factory=QpIkParams)
     d_min: float = 0.0
+    task: Task = field(default_factory=Task)
     iterations: int = field(default=0, init=False)
     infeasible: int = field(default=0, init=False)
-    _previous_ref: np.ndarray | None = field(default=None, init=False)
+    _previous: Target | None = field(default=None, init=False)
 
     def reset(self) -> None:
-        """Forget the previous reference point: the next period has no feed-forward."""
-        self._previous_ref = None
+        """Forget the previous target: the next period has no feed-forward."""
+        self._previous = None
 
-    def step(self, q: np.ndarray, x_ref: np.ndarray, t: float) -> np.ndarray:
+    def step(self, q: np.ndarray, target: Target | np.ndarray, t: float) -> np.ndarray:
         """One period: solve for q̇ (stop if the QP has no solution) and integrate for dt."""
-        qdot = self._solve(q, x_ref, t)
+        qdot = self._solve(q, as_target(target), t)
         self.iterations += 1
         if qdot is None:
             self.infeasible += 1
             return q.copy()
         return self.scene.robot.clip(q + self.dt * qdot)
 
-    def _solve(self, q: np.ndarray, x_ref: np.ndarray, t: float) -> np.ndarray | None:
+    def _solve(self, q: np.ndarray, target: Target | np.ndarray, t: float) -> np.ndarray | None:
         robot, p, n = self.scene.robot, self.params, self.scene.robot.nq
-        x = robot.ee_position(q)
-        v = reference_velocity(x_ref, self._previous_ref, x, self.dt, p.gain)
-        self._previous_ref = x_ref.copy()
-        J = robot.jacobian(q)[:3]
-        P = np.diag(np.r_[np.full(n, p.joint_weight), np.full(3, p.slack_weight)])
-        A = np.hstack([J, np.eye(3)])
+        J, v = task_rows(robot, q, self.task, target, self._previous, self.dt, p.gain)
+        self._previous = target
+        m = J.shape[0]  # task rows, each with its slack
+        P = np.diag(np.r_[np.full(n, p.joint_weight), np.full(m, p.slack_weight)])
+        A = np.hstack([J, np.eye(m)])
         G_rows, h_rows = [], []
         if self.scene.has_clearance:
             rows = clearance_rows(self.scene, q, t, p.influence)
@@ -88,19 +90,19 @@ class QpIk:
                     continue  # a world-fixed link: no joint changes d, so no row can help
                 # −∇d·q̇ ≤ ξ (d − d_s)/(d_i − d_s): approach no faster than the damper allows.
                 safety = p.self_safety if itself else p.safety
-                G_rows.append(np.r_[-grad, np.zeros(3)])
+                G_rows.append(np.r_[-grad, np.zeros(m)])
                 h_rows.append(p.damper_gain * (d - safety) / (p.influence - safety))
         for j in range(n):
             for sign, room in ((1.0, robot.upper[j] - q[j]), (-1.0, q[j] - robot.lower[j])):
                 if room < p.limit_influence:
-                    row = np.zeros(n + 3)
+                    row = np.zeros(n + m)
                     row[j] = sign
                     G_rows.append(row)
                     span = p.limit_influence - p.limit_safety
                     h_rows.append(p.damper_gain * (room - p.limit_safety) / span)
         limit = p.speed_scale * np.where(robot.velocity_limit > 0, robot.velocity_limit, 1e3)
-        bound = np.r_[limit, np.full(3, 1e3)]
+        bound = np.r_[limit, np.full(m, 1e3)]
         G = np.array(G_rows) if G_rows else None
         h = np.array(h_rows) if h_rows else None
-        solution = qpsolvers.solve_qp(P, np.zeros(n + 3), G, h, A, v, -bound, bound, solver="daqp")
+        solution = qpsolvers.solve_qp(P, np.zeros(n + m), G, h, A, v, -bound, bound, solver="daqp")
         return None if solution is None else solution[:n]

@@ -1,9 +1,15 @@
-"""The end-effector velocity a resolved-rate controller commands over one control period."""
+"""The end-effector velocity a resolved-rate controller commands over one control period, and
+the task rows (position, pose or tool axis) it is commanded through."""
 
 from __future__ import annotations
 
-import numpy as np
+import math
 
+import numpy as np
+import pinocchio as pin
+
+from articula.planning.task import Target, Task, target_arrays
+from articula.robots.model import RobotModel
 from articula.validation import NonNegative, Positive, StrictModel
 
 
@@ -34,3 +40,64 @@ def reference_velocity(
     if previous_ref is None:
         return gain * (x_ref - x)
     return (x_ref - previous_ref) / dt + gain * (previous_ref - x)
+
+
+def task_rows(
+    robot: RobotModel,
+    q: np.ndarray,
+    task: Task,
+    target: Target,
+    previous: Target | None,
+    dt: float,
+    gain: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """(J_task, v): the task Jacobian rows (rows × nq) and the velocity they should have.
+
+    Position: J_v (3 rows) and ẋ_r + K e (reference_velocity). Pose: also J_ω (3 rows) and
+    ω = log(R_r R_r,prevᵀ)/dt + K log(R_r,prev Rᵀ), the same feed-forward and feedback on the
+    rotation (world axes). Position+axis: the two rows of J_ω across the tool axis a, and
+    there the rotation that takes a to the reference axis (its feed-forward likewise).
+    """
+    J = robot.jacobian(q)
+    robot.forward(q)
+    placement = robot.data.oMf[robot.ee_frame_id]
+    x, R = placement.translation, placement.rotation
+    v = reference_velocity(
+        target.position, None if previous is None else previous.position, x, dt, gain
+    )
+    if task.kind == "position":
+        return J[:3], v
+    rotation, axis = target_arrays(task, target)
+    if task.kind == "pose":
+        if previous is None:
+            w = gain * pin.log3(rotation @ R.T)
+        else:
+            before = target_arrays(task, previous)[0]
+            w = pin.log3(rotation @ before.T) / dt + gain * pin.log3(before @ R.T)
+        return np.vstack([J[:3], J[3:]]), np.r_[v, w]
+    a = R @ task.tool_axis
+    if previous is None:
+        w = gain * rotation_vector(a, axis)
+    else:
+        before = target_arrays(task, previous)[1]
+        w = rotation_vector(before, axis) / dt + gain * rotation_vector(a, before)
+    across = _across(a)  # spin about a itself leaves the axis where it is: not a task row
+    return np.vstack([J[:3], across @ J[3:]]), np.r_[v, across @ w]
+
+
+def rotation_vector(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The rotation vector [rad] of the shortest rotation taking unit vector a to b."""
+    cross = np.cross(a, b)
+    sine = float(np.linalg.norm(cross))
+    angle = math.atan2(sine, float(a @ b))
+    if sine < 1e-12:
+        return np.zeros(3)  # aligned (or exactly opposite: no unique shortest rotation)
+    return cross / sine * angle
+
+
+def _across(a: np.ndarray) -> np.ndarray:
+    """Two orthonormal rows perpendicular to unit vector a (2 × 3)."""
+    helper = np.array([1.0, 0.0, 0.0]) if abs(a[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    u = np.cross(a, helper)
+    u /= np.linalg.norm(u)
+    return np.vstack([u, np.cross(a, u)])

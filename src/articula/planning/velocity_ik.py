@@ -9,7 +9,8 @@ from typing import Literal
 import numpy as np
 
 from articula.planning.clearance import clearance_rows
-from articula.planning.reference_velocity import RateParams, reference_velocity
+from articula.planning.reference_velocity import RateParams, task_rows
+from articula.planning.task import Target, Task, as_target
 from articula.scene.scene import Scene
 from articula.validation import NonNegative
 
@@ -31,32 +32,34 @@ class VelocityIkParams(RateParams):
 
 @dataclass
 class VelocityIk:
-    """Resolved-rate control of the end-effector position at control period dt [s]."""
+    """Resolved-rate control of the end effector's task (position, pose or axis) at control
+    period dt [s]."""
 
     scene: Scene
     method: Literal["pinv", "dls"]
     dt: float
     params: VelocityIkParams = field(default_factory=VelocityIkParams)
     d_min: float = 0.0
+    task: Task = field(default_factory=Task)
     iterations: int = field(default=0, init=False)
-    _previous_ref: np.ndarray | None = field(default=None, init=False)
+    _previous: Target | None = field(default=None, init=False)
 
     def reset(self) -> None:
-        """Forget the previous reference point: the next period has no feed-forward."""
-        self._previous_ref = None
+        """Forget the previous target: the next period has no feed-forward."""
+        self._previous = None
 
-    def step(self, q: np.ndarray, x_ref: np.ndarray, t: float) -> np.ndarray:
+    def step(self, q: np.ndarray, target: Target | np.ndarray, t: float) -> np.ndarray:
         """One period: integrate q̇ for dt and clip to the joint limits."""
         robot, p = self.scene.robot, self.params
-        x = robot.ee_position(q)
-        v = reference_velocity(x_ref, self._previous_ref, x, self.dt, p.gain)
-        self._previous_ref = x_ref.copy()
-        J = robot.jacobian(q)[:3]
+        target = as_target(target)
+        J, v = task_rows(robot, q, self.task, target, self._previous, self.dt, p.gain)
+        self._previous = target
+        m = J.shape[0]
         # Singular values below 1e-6 of the largest are round-off (the stretched home pose has
         # 1e-13): inverting them would let the last bits of q choose the direction of motion.
         J_pinv = np.linalg.pinv(J, rcond=PINV_CUTOFF)
         if self.method == "dls":
-            J_task = J.T @ np.linalg.solve(J @ J.T + p.damping**2 * np.eye(3), np.eye(3))
+            J_task = J.T @ np.linalg.solve(J @ J.T + p.damping**2 * np.eye(m), np.eye(m))
         else:
             J_task = J_pinv
         limit = p.speed_scale * robot.velocity_limit

@@ -40,6 +40,7 @@ class CompiledClearance:
     q_index: np.ndarray  # (joints,) index of the joint's angle in q
     ee_joint: int
     ee_p: np.ndarray  # end-effector origin in its joint frame
+    ee_rot: np.ndarray  # end-effector orientation in its joint frame (3×3)
     vertices: np.ndarray  # (total, 3) cores of every shape in their own frame, concatenated
     starts: np.ndarray  # (shapes + 1,) offsets into vertices
     neighbours: np.ndarray  # vertices joined by a hull edge, CSR by vertex (global indices)
@@ -106,6 +107,7 @@ class CompiledClearance:
             q_index=np.array(model.idx_qs, dtype=np.int64),
             ee_joint=int(model.frames[scene.robot.ee_frame_id].parentJoint),
             ee_p=np.array(model.frames[scene.robot.ee_frame_id].placement.translation),
+            ee_rot=np.array(model.frames[scene.robot.ee_frame_id].placement.rotation),
             vertices=np.concatenate([c[0] for c in cores] or [np.zeros((0, 3))]),
             starts=starts,
             neighbours=neighbours,
@@ -132,10 +134,10 @@ class CompiledClearance:
 
     def evaluate(
         self, q: np.ndarray, obstacles: bool = True, self_pairs: bool = True
-    ) -> tuple[float, float, np.ndarray]:
-        """(obstacle clearance [m], self clearance [m], end-effector position [m]) at q [rad];
-        a clearance is 0 on overlap and +inf without pairs of its kind or when not asked for
-        (both False: kinematics only)."""
+    ) -> tuple[float, float, np.ndarray, np.ndarray]:
+        """(obstacle clearance [m], self clearance [m], end-effector position [m] and rotation
+        (3×3, world)) at q [rad]; a clearance is 0 on overlap and +inf without pairs of its
+        kind or when not asked for (both False: kinematics only)."""
         pairs, static_min = self.select(obstacles, self_pairs)
         return _evaluate(q, *self.arrays(pairs), static_min)
 
@@ -148,7 +150,7 @@ class CompiledClearance:
         """The arguments of the compiled evaluation after q (all but static_min)."""
         pairs = self.pairs if pairs is None else pairs
         return (self.parents, self.joint_rot, self.joint_p, self.axes, self.q_index,
-                self.ee_joint, self.ee_p, self.vertices, self.starts, self.neighbours,
+                self.ee_joint, self.ee_p, self.ee_rot, self.vertices, self.starts, self.neighbours,
                 self.offsets, self.hints, self.guesses, self.radii,
                 self.shape_joint, self.shape_rot, self.shape_p, self.capsule_a, self.capsule_b,
                 self.capsule_r, pairs)  # fmt: skip
@@ -267,13 +269,14 @@ def _segment_distance(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.nda
 
 @jit()
 def _evaluate(
-    q, parents, joint_rot, joint_p, axes, q_index, ee_joint, ee_p, vertices, starts,
+    q, parents, joint_rot, joint_p, axes, q_index, ee_joint, ee_p, ee_rot, vertices, starts,
     neighbours, offsets, hints, guesses, radii, shape_joint, shape_rot, shape_p, capsule_a,
     capsule_b, capsule_r, pairs, static_min,
 ):  # fmt: skip
-    """(obstacle clearance, self clearance, end-effector position): forward kinematics, shape
-    poses, capsule lower bounds, then exact GJK in order of bound, skipping a pair whose bound
-    is not below the best distance of its kind (the broad phase of Scene)."""
+    """(obstacle clearance, self clearance, end-effector position, end-effector rotation):
+    forward kinematics, shape poses, capsule lower bounds, then exact GJK in order of bound,
+    skipping a pair whose bound is not below the best distance of its kind (the broad phase
+    of Scene)."""
     nj = parents.size
     oR = np.empty((nj, 3, 3))
     op = np.empty((nj, 3))
@@ -286,6 +289,8 @@ def _evaluate(
         _rotate_about(placed, axes[j], q[q_index[j]], oR[j])
     ee = np.empty(3)
     _apply(oR[ee_joint], op[ee_joint], ee_p, ee)
+    ee_R = np.empty((3, 3))
+    _compose(oR[ee_joint], op[ee_joint], ee_rot, ee_p, ee_R, np.empty(3))
     ns = radii.size
     world_R = np.empty((ns, 3, 3))
     world_p = np.empty((ns, 3))
@@ -328,4 +333,4 @@ def _evaluate(
             best_self = d
         elif not self_pair and d < best_obstacle:
             best_obstacle = d
-    return best_obstacle, best_self, ee
+    return best_obstacle, best_self, ee, ee_R

@@ -3,9 +3,9 @@ for the link pairs it is given, link-link (self) distances.
 
 Robot link shapes and obstacle parts live in one Pinocchio GeometryModel, one collision pair
 per (link shape, obstacle part) and per (shape, shape) of a checked link pair, so forward
-kinematics, placements and every exact distance run in C++. A second model holds a bounding capsule per shape: capsule-capsule distances
-(closed form in coal) are lower bounds of the exact ones, which lets the broad phase skip
-pairs that cannot be the minimum.
+kinematics, placements and every exact distance run in C++. A second model holds a bounding
+capsule per shape: capsule-capsule distances (closed form in coal) are lower bounds of the
+exact ones, which lets the broad phase skip pairs that cannot be the minimum.
 """
 
 from __future__ import annotations

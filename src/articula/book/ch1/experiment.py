@@ -15,7 +15,7 @@ from pydantic import model_validator
 
 from articula.errors import ConfigError, InfeasibleError
 from articula.loops.tracking import trace_columns, track, tracking_metrics
-from articula.planning.config import PlannerSpec, TrajectorySpec, make_planner, make_trajectory
+from articula.planning.config import PlannerSpec, TrajectorySpec, make_planner, make_targets
 from articula.planning.reach import check_reach
 from articula.runs.registry import Experiment, Progress, Result
 from articula.scene.config import PACKAGE_URI, SceneSpec, build_scene, resolve_path
@@ -54,13 +54,13 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
     """
     base = Path.cwd()
     scene, q0 = build_scene(config, base)
-    trajectory = make_trajectory(config.trajectory, base)
+    targets = make_targets(config.trajectory, base)
     p = config.planner
     with fields_as(_CONFIG_PATHS):
-        check_reach(scene.robot, trajectory, p.duration)
+        check_reach(scene.robot, targets.positions, p.duration)
         planner = make_planner(p, scene, config.seed)
-        run = track(planner, trajectory, q0, p.dt, p.duration, p.max_steps, progress)
-    metrics = tracking_metrics(run, scene.robot, p.settle or 0.0, planner.iterations)
+        run = track(planner, targets, q0, p.dt, p.duration, p.max_steps, progress)
+    metrics = tracking_metrics(run, scene.robot, p.settle or 0.0, planner.iterations, targets.cone)
     if metrics["rms_error"] > p.tolerance:
         raise InfeasibleError(
             f"not tracked: rms error {metrics['rms_error']:.3g} m after {p.settle} s (max "

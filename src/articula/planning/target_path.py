@@ -1,0 +1,80 @@
+"""Targets over time: a position path with an optional orientation (fixed, or per waypoint and
+interpolated) and an optional tool axis direction."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation, Slerp
+
+from articula.errors import ConfigError
+from articula.geometry.poses import pose
+from articula.planning.task import Target, unit
+
+
+@dataclass(frozen=True)
+class WaypointRotations:
+    """Orientations reached at increasing times [s], interpolated along the shortest rotation
+    (slerp) between them and held before the first and after the last."""
+
+    times: np.ndarray
+    slerp: Slerp
+
+    @classmethod
+    def create(cls, rotations: Sequence[np.ndarray], times: Sequence[float]) -> WaypointRotations:
+        """From one 3×3 rotation per time; times as the waypoints' (checked there)."""
+        t = np.asarray(times, dtype=float)
+        if len(rotations) != len(t):
+            raise ConfigError("rpys", f"needs {len(t)} orientations, one per point")
+        return cls(t, Slerp(t, Rotation.from_matrix(np.asarray(rotations))))
+
+    def __call__(self, t: float) -> np.ndarray:
+        """The orientation (3×3, world) at time t [s]."""
+        return self.slerp(np.clip(t, self.times[0], self.times[-1])).as_matrix()
+
+
+@dataclass(frozen=True)
+class TargetPath:
+    """Target(t): the position path's point, the orientation at t, the fixed axis.
+
+    Attributes:
+        positions: t [s] -> position [m].
+        rotations: t [s] -> orientation (3×3, world); None: no orientation given.
+        axis: unit world direction for the tool axis; None: none given.
+        cone: [rad] how far the tool axis may be from `axis` (for the record's count).
+    """
+
+    positions: Callable[[float], np.ndarray]
+    rotations: Callable[[float], np.ndarray] | None = None
+    axis: np.ndarray | None = None
+    cone: float | None = None
+
+    def __call__(self, t: float) -> Target:
+        """The target at time t [s]."""
+        rotation = None if self.rotations is None else self.rotations(t)
+        return Target(self.positions(t), rotation, self.axis)
+
+
+def fixed_rotation(rotation: np.ndarray) -> Callable[[float], np.ndarray]:
+    """A constant orientation as a function of time."""
+    return lambda t: rotation
+
+
+def rotation_from(rpy: Sequence[float] | None, quaternion: Sequence[float] | None) -> np.ndarray:
+    """A rotation (3×3) from roll-pitch-yaw [rad] (about fixed x, y, z) or a quaternion
+    [w, x, y, z] (normalised here)."""
+    if quaternion is not None:
+        w, x, y, z = quaternion
+        if np.linalg.norm(quaternion) < 1e-9:
+            raise ConfigError("quaternion", "needs a non-zero quaternion [w, x, y, z]")
+        return Rotation.from_quat([x, y, z, w]).as_matrix()
+    if rpy is None:
+        raise ConfigError("rpy", "give rpy = [roll, pitch, yaw] or quaternion = [w, x, y, z]")
+    return pose((0.0, 0.0, 0.0), rpy)[:3, :3]  # the URDF's convention, as for obstacles
+
+
+def axis_direction(axis: Sequence[float]) -> np.ndarray:
+    """A tool-axis direction from the [trajectory] table as a unit vector."""
+    return unit(np.asarray(axis, dtype=float), "axis")
