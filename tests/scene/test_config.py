@@ -158,3 +158,27 @@ def test_robot_table_ee_offset_and_locked_joints_are_validated(table):
     with pytest.raises(ConfigError) as err:
         load_scene_spec({"robot": {"urdf": "turn.urdf", **table}})
     assert "robot" in str(err.value)
+
+
+@pytest.mark.parametrize("robot_table", [{"urdf": "turn.urdf"}, {"builtin": "iiwa14"}])
+def test_decomposing_an_unknown_link_names_robot_decompose(tmp_path, write_toml, robot_table):
+    (tmp_path / "turn.urdf").write_text(TURN_URDF)
+    path = write_toml({"robot": {**robot_table, "decompose": ["ball", "nope"]}}, "scene.toml")
+    with pytest.raises(ConfigError) as err:
+        build_scene(load_scene_spec(load_toml(path)), tmp_path)
+    assert err.value.field == "robot.decompose"
+    assert "'nope'" in err.value.problem and "the links are [" in err.value.problem
+
+
+@pytest.mark.parametrize("decompose", ["ball", 1, [1], {"ball": True}])
+def test_robot_decompose_is_a_boolean_or_link_names(decompose):
+    with pytest.raises(ConfigError) as err:
+        load_scene_spec({"robot": {"urdf": "turn.urdf", "decompose": decompose}})
+    assert "robot.decompose" in str(err.value)
+
+
+def test_robot_decompose_of_links_without_meshes_changes_nothing(tmp_path, write_toml):
+    (tmp_path / "turn.urdf").write_text(TURN_URDF)
+    path = write_toml({"robot": {"urdf": "turn.urdf", "decompose": True}}, "scene.toml")
+    scene, _ = build_scene(load_scene_spec(load_toml(path)), tmp_path)
+    assert [s.kind for link in scene.robot.links for s in link.shapes] == ["sphere", "sphere"]

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -62,6 +62,7 @@ class RobotModel:
         max_links: int = MAX_LINKS,
         locked_joints: Mapping[str, float] | None = None,
         ee_offset: np.ndarray | None = None,
+        decompose: bool | Collection[str] = False,
     ) -> RobotModel:
         """Load kinematics and collision shapes.
 
@@ -78,6 +79,10 @@ class RobotModel:
                 puts them. Mimic joints of a locked joint are locked with it.
             ee_offset: pose (4×4) of the tool point in the `ee_frame` frame [m]; the tool
                 point becomes a new frame, named `<ee_frame>_offset`, and the end effector.
+            decompose: link meshes to split into convex parts with CoACD (cached on disk, see
+                geometry.meshes.cache_folder) instead of one hull per separate part: True for
+                every link, or link names; a non-convex link then keeps its concavities
+                (tighter clearance) at the cost of a decomposition on first load.
         """
         urdf = Path(path)
         if not urdf.is_file():
@@ -98,7 +103,7 @@ class RobotModel:
         _check_magnitudes(model, urdf)
         if locked_joints:
             model = _lock(model, dict(locked_joints), mimics)
-        shapes = collision_shapes(urdf, [Path(d) for d in package_dirs])
+        shapes = collision_shapes(urdf, [Path(d) for d in package_dirs], decompose)
         links = []
         for name, items in shapes.items():
             if not model.existFrame(name, pin.FrameType.BODY):
@@ -121,6 +126,7 @@ class RobotModel:
         ee_frame: str | None = None,
         locked_joints: Mapping[str, float] | None = None,
         ee_offset: np.ndarray | None = None,
+        decompose: bool | Collection[str] = False,
     ) -> RobotModel:
         """A robot shipped with articula.
 
@@ -129,6 +135,7 @@ class RobotModel:
             ee_frame: overrides its end-effector frame.
             locked_joints: joint name -> fixed value [rad or m] (see `from_urdf`).
             ee_offset: pose (4×4) of the tool point in the end-effector frame [m].
+            decompose: link meshes to decompose with CoACD (see `from_urdf`).
         """
         if name not in BUILTIN:
             raise ConfigError("builtin", f"unknown robot {name!r}; choose one of {sorted(BUILTIN)}")
@@ -139,6 +146,7 @@ class RobotModel:
                 ee_frame=ee_frame or default_frame,
                 locked_joints=locked_joints,
                 ee_offset=ee_offset,
+                decompose=decompose,
             )
 
     @property

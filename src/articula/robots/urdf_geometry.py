@@ -3,30 +3,42 @@
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from pathlib import Path
 
 import numpy as np
 import trimesh
 
-from articula.errors import GeometryError, ModelError
-from articula.geometry.meshes import load_mesh
+from articula.errors import ConfigError, GeometryError, ModelError
+from articula.geometry.meshes import convex_parts, load_mesh
 from articula.geometry.poses import pose
 from articula.geometry.shapes import ConvexShape, box, convex_hull, cylinder, sphere
+from articula.limits import MAX_DECOMPOSE_VERTICES
 
 MAX_LINK_PARTS = 64  # more separate parts in one link mesh: noise, not a decomposition
 
 
 def collision_shapes(
-    urdf: Path, package_dirs: Sequence[Path] = ()
+    urdf: Path, package_dirs: Sequence[Path] = (), decompose: bool | Collection[str] = False
 ) -> dict[str, list[tuple[ConvexShape, np.ndarray]]]:
-    """Link name -> [(shape, pose of the shape in the link frame)] for every <collision>."""
+    """Link name -> [(shape, pose of the shape in the link frame)] for every <collision>.
+
+    Args:
+        urdf: the URDF file.
+        package_dirs: folders that hold the packages its package:// meshes name.
+        decompose: which links' meshes CoACD decomposes into convex parts (cached on disk,
+            see geometry.meshes.convex_parts) instead of one hull per separate part: True for
+            every link, False for none, or link names (ConfigError "decompose" for a name the
+            URDF has no link of).
+    """
     try:
         root = ET.parse(urdf).getroot()
     except (ET.ParseError, OSError) as exc:
         raise ModelError(f"{urdf}: cannot read URDF ({exc})") from None
+    links = root.findall("link")
+    chosen = _decomposed_links(decompose, [link.get("name", "") for link in links])
     shapes: dict[str, list[tuple[ConvexShape, np.ndarray]]] = {}
-    for link in root.findall("link"):
+    for link in links:
         name = link.get("name", "")
         for i, element in enumerate(link.findall("collision")):
             geometry = element.find("geometry")
@@ -34,9 +46,23 @@ def collision_shapes(
                 raise ModelError(f"{urdf}: link {name!r} has a <collision> without <geometry>")
             where = f"{urdf}: link {name!r} collision {i}"
             origin = _origin(element.find("origin"), where)
-            for shape in _shapes(geometry[0], urdf, package_dirs, where):
+            for shape in _shapes(geometry[0], urdf, package_dirs, where, name in chosen):
                 shapes.setdefault(name, []).append((shape, origin))
     return shapes
+
+
+def _decomposed_links(decompose: bool | Collection[str], names: Sequence[str]) -> set[str]:
+    """The link names whose meshes are decomposed; ConfigError for a name of no link."""
+    if isinstance(decompose, bool):
+        return set(names) if decompose else set()
+    # One string is one link name, not a collection of one-letter names.
+    wanted = {decompose} if isinstance(decompose, str) else set(decompose)
+    unknown = sorted(wanted - set(names))
+    if unknown:
+        raise ConfigError(
+            "decompose", f"no link {', '.join(map(repr, unknown))}; the links are {list(names)}"
+        )
+    return wanted
 
 
 def resolve_mesh_path(filename: str, urdf: Path, package_dirs: Sequence[Path]) -> Path:
@@ -60,14 +86,26 @@ def resolve_mesh_path(filename: str, urdf: Path, package_dirs: Sequence[Path]) -
 
 
 def _shapes(
-    element: ET.Element, urdf: Path, package_dirs: Sequence[Path], where: str
+    element: ET.Element, urdf: Path, package_dirs: Sequence[Path], where: str, decompose: bool
 ) -> list[ConvexShape]:
-    """The convex shapes of one <geometry> child: a mesh gives one per separate part."""
+    """The convex shapes of one <geometry> child: a mesh gives one per separate part, or its
+    CoACD parts when `decompose`."""
     try:
         if element.tag == "mesh":
             path = resolve_mesh_path(element.get("filename", ""), urdf, package_dirs)
             scale = _floats(element.get("scale", "1 1 1"), 3, where)
-            return mesh_parts(load_mesh(path, scale), str(path))
+            mesh = load_mesh(path, scale)
+            if decompose:
+                if len(mesh.vertices) > MAX_DECOMPOSE_VERTICES:  # its run would take long
+                    raise GeometryError(
+                        f"{path.name} has {len(mesh.vertices):,} vertices, more than the "
+                        f"{MAX_DECOMPOSE_VERTICES:,} a decomposition takes; simplify the mesh "
+                        "or leave the link out of decompose"
+                    )
+                # The obstacles' decomposition and its disk cache: a mesh shared by links or
+                # loaded again is decomposed once.
+                return convex_parts(mesh, str(path), decompose=True)
+            return mesh_parts(mesh, str(path))
         if element.tag == "box":
             return [box(_floats(element.get("size", ""), 3, where))]
         if element.tag == "cylinder":
@@ -89,7 +127,8 @@ def mesh_parts(mesh: trimesh.Trimesh, name: str) -> list[ConvexShape]:
     """One convex hull per separate part of a link mesh (a V-HACD file holds its convex
     pieces as separate parts; one hull over them all would fill the gaps between them), or
     the hull of the whole mesh when it is one part, has too many, or a part has no volume."""
-    pieces = mesh.split(only_watertight=False)
+    # No repair: hulls need only the vertices, and trimesh's hole filling needs networkx.
+    pieces = mesh.split(only_watertight=False, repair=False)
     if 1 < len(pieces) <= MAX_LINK_PARTS:
         try:
             return [convex_hull(p.vertices, f"{name}[{i}]") for i, p in enumerate(pieces)]

@@ -17,7 +17,12 @@ from articula.limits import MAX_DECOMPOSE_VERTICES, MAX_LENGTH, MAX_LINKS, MAX_S
 from articula.robots.model import RobotModel
 from articula.scene.obstacles import Obstacle
 from articula.scene.scene import Metric, Scene
-from articula.scene.self_collision import MARGIN, SAMPLES, SelfCollisionMatrix, self_collision_matrix
+from articula.scene.self_collision import (
+    MARGIN,
+    SAMPLES,
+    SelfCollisionMatrix,
+    self_collision_matrix,
+)
 from articula.validation import (
     Point,
     PositiveLength,
@@ -54,6 +59,9 @@ class RobotSpec(StrictModel):
     locked_joints: dict[str, Radians] = Field(default_factory=dict)  # joint -> [rad or m]
     q0: list[Radians] | None = None
     max_links: Annotated[int, Field(ge=1, le=100_000)] = MAX_LINKS  # refuse larger URDFs
+    # Link meshes CoACD decomposes (true: all; or link names) instead of one hull per part:
+    # a non-convex link keeps its concavities, so clearance is not under-stated there.
+    decompose: bool | list[str] = False
     # Link-link distances count as clearance, for the pairs of scene/self_collision.py's
     # allowed-collision matrix; allow_pairs are never checked.
     self_collision: bool = False
@@ -123,7 +131,9 @@ def build_scene(
     offset = None if r.ee_offset is None else pose(r.ee_offset.xyz, r.ee_offset.rpy)
     with fields_as(fields):
         if r.builtin is not None:
-            robot = RobotModel.builtin(r.builtin, r.ee_frame, r.locked_joints, offset)
+            robot = RobotModel.builtin(
+                r.builtin, r.ee_frame, r.locked_joints, offset, decompose=r.decompose
+            )
         else:
             robot = RobotModel.from_urdf(
                 resolve_path(base_dir, r.urdf or ""),
@@ -132,6 +142,7 @@ def build_scene(
                 r.max_links,
                 r.locked_joints,
                 offset,
+                decompose=r.decompose,
             )
     q0 = robot.check_q(r.q0 if r.q0 is not None else np.zeros(robot.nq), "robot.q0")
     obstacles = []
