@@ -105,19 +105,25 @@ def test_non_positive_primitive_in_urdf(build_edited):
     assert "sphere" in str(exc.value) and "link2" in str(exc.value)
 
 
+def _mesh_link(folder: Path, mesh: str):
+    """The one link with shapes of a one-joint URDF whose tool link is the mesh file `mesh`."""
+    (folder / "arm.urdf").write_text(
+        '<robot name="r"><link name="base"/><link name="tool"><collision><geometry>'
+        f'<mesh filename="{mesh}"/></geometry></collision></link>'
+        '<joint name="j" type="revolute"><parent link="base"/><child link="tool"/>'
+        '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>'
+    )
+    (link,) = [k for k in RobotModel.from_urdf(folder / "arm.urdf").links if k.shapes]
+    return link
+
+
 def test_a_link_mesh_of_separate_convex_parts_keeps_one_hull_per_part(tmp_path):
     tetra = "v {x} 0 0\nv {x1} 0 0\nv {x} 1 0\nv {x} 0 1\n"
     faces = "f {a} {c} {b}\nf {a} {b} {d}\nf {a} {d} {c}\nf {b} {c} {d}\n"
     obj = (tetra.format(x=0, x1=1) + faces.format(a=1, b=2, c=3, d=4)
            + tetra.format(x=3, x1=4) + faces.format(a=5, b=6, c=7, d=8))  # fmt: skip
     (tmp_path / "parts.obj").write_text(obj)
-    (tmp_path / "arm.urdf").write_text(
-        '<robot name="r"><link name="base"/><link name="tool"><collision><geometry>'
-        '<mesh filename="parts.obj"/></geometry></collision></link>'
-        '<joint name="j" type="revolute"><parent link="base"/><child link="tool"/>'
-        '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>'
-    )
-    (link,) = [k for k in RobotModel.from_urdf(tmp_path / "arm.urdf").links if k.shapes]
+    link = _mesh_link(tmp_path, "parts.obj")
     assert len(link.shapes) == 2
     # A point in the gap between the parts is outside both, though inside their common hull.
     gap = coal.Sphere(0.01)
@@ -135,13 +141,7 @@ def test_a_link_mesh_with_holes_gives_its_hull(tmp_path):
     # into parts must not try to repair them (trimesh's repair needs networkx).
     closed = trimesh.creation.box(extents=(0.2, 0.4, 0.6))
     trimesh.Trimesh(closed.vertices, closed.faces[:-2]).export(tmp_path / "open.stl")
-    (tmp_path / "arm.urdf").write_text(
-        '<robot name="r"><link name="base"/><link name="tool"><collision><geometry>'
-        '<mesh filename="open.stl"/></geometry></collision></link>'
-        '<joint name="j" type="revolute"><parent link="base"/><child link="tool"/>'
-        '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>'
-    )
-    (link,) = [k for k in RobotModel.from_urdf(tmp_path / "arm.urdf").links if k.shapes]
+    link = _mesh_link(tmp_path, "open.stl")
     (hull,) = link.shapes
     _same_hull(hull.vertices, np.asarray(closed.vertices))
 

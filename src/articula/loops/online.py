@@ -125,7 +125,8 @@ class OnlineController:
                 known = ", ".join(sorted(self.live)) or "none (build it with live_obstacles)"
                 raise ConfigError("obstacle_poses", f"no live obstacle {name!r}; live: {known}")
             try:
-                self.live[name].pose = check_pose(name, np.asarray(pose, dtype=float))
+                pose = np.asarray(pose, dtype=float)
+                self.live[name].pose = check_pose(f"obstacle {name!r}", pose)
             except GeometryError as exc:
                 raise ConfigError(f"obstacle_poses.{name}", str(exc)) from None
         self.target = self._complete(target)
@@ -138,11 +139,11 @@ class OnlineController:
         if not isinstance(target, Target):
             arr = np.asarray(target, dtype=float)
             if arr.shape == (4, 4):
-                R = arr[:3, :3]
-                if not (np.all(np.isfinite(arr)) and np.allclose(R @ R.T, np.eye(3), atol=1e-6)
-                        and np.linalg.det(R) > 0):  # fmt: skip
-                    raise ConfigError("target", "a 4×4 pose needs a finite rotation and position")
-                target = Target(arr[:3, 3].copy(), R.copy())
+                try:
+                    check_pose("the target", arr)
+                except GeometryError as exc:
+                    raise ConfigError("target", str(exc)) from None
+                target = Target(arr[:3, 3].copy(), arr[:3, :3].copy())
             else:
                 target = Target(arr)
         position = np.asarray(target.position, dtype=float)

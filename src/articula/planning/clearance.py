@@ -29,45 +29,39 @@ def clearance_rows(scene: Scene, q: np.ndarray, t: float, influence: float) -> C
     ∇d = n·(J_a − J_b) with n from b's closest point to a's.
     """
     robot = scene.robot
-    rows, normals = [], []
-    frames, points = [], []  # the point on the link (a) that ∇d follows
-    pairs = []  # per row: None, or the frame and point of link b
+    # Per row: its distance, the unit normal n, and the points whose motion moves it, each as
+    # (frame, world point, +1 for link a | −1 for link b).
+    rows: list[tuple[float, np.ndarray, list[tuple[int, np.ndarray, float]]]] = []
     w = scene.witnesses(q, t)
     for li, oi in zip(*np.nonzero(w.distance < influence), strict=True):
-        if _add_row(rows, normals, w.distance[li, oi], w.on_link[li, oi], w.on_obstacle[li, oi]):
-            frames.append(robot.links[li].frame_id)
-            points.append(w.on_link[li, oi])
-            pairs.append(None)
+        n = _normal(w.distance[li, oi], w.on_link[li, oi], w.on_obstacle[li, oi])
+        if n is not None:
+            on_link = [(robot.links[li].frame_id, w.on_link[li, oi], 1.0)]
+            rows.append((w.distance[li, oi], n, on_link))
+    n_obstacle_rows = len(rows)
     if scene.self_pairs:
         s = scene.self_witnesses(q)
         for k in np.nonzero(s.distance < influence)[0]:
-            if _add_row(rows, normals, s.distance[k], s.on_a[k], s.on_b[k]):
+            n = _normal(s.distance[k], s.on_a[k], s.on_b[k])
+            if n is not None:
                 a, b = scene.self_pairs[k]
-                frames.append(robot.links[a].frame_id)
-                points.append(s.on_a[k])
-                pairs.append((robot.links[b].frame_id, s.on_b[k]))
-    others = [pair for pair in pairs if pair is not None]
-    jacobians = robot.point_jacobians(
-        q, frames + [f for f, _ in others], points + [p for _, p in others]
-    )
-    grads, e = [], len(frames)
-    for n, J, pair in zip(normals, jacobians, pairs, strict=False):
-        if pair is None:
-            grads.append(n @ J)
-        else:
-            grads.append(n @ (J - jacobians[e]))
-            e += 1
-    flags = np.array([pair is not None for pair in pairs], dtype=bool)
-    return ClearanceRows(np.array(rows), np.array(grads).reshape(len(rows), robot.nq), flags)
+                ends = [(robot.links[a].frame_id, s.on_a[k], 1.0),
+                        (robot.links[b].frame_id, s.on_b[k], -1.0)]  # fmt: skip
+                rows.append((s.distance[k], n, ends))
+    terms = [term for _, _, row_terms in rows for term in row_terms]
+    jacobians = iter(robot.point_jacobians(q, [f for f, _, _ in terms], [p for _, p, _ in terms]))
+    grads = [n @ sum(sign * next(jacobians) for _, _, sign in row_terms)
+             for _, n, row_terms in rows]  # fmt: skip
+    flags = np.arange(len(rows)) >= n_obstacle_rows
+    distances = np.array([d for d, _, _ in rows])
+    return ClearanceRows(distances, np.array(grads).reshape(len(rows), robot.nq), flags)
 
 
-def _add_row(rows: list, normals: list, d: float, on_a: np.ndarray, on_b: np.ndarray) -> bool:
-    """Append d and the unit normal from b to a (toward more clearance); False when the
-    points coincide and there is no direction to move away along."""
+def _normal(d: float, on_a: np.ndarray, on_b: np.ndarray) -> np.ndarray | None:
+    """The unit normal from b's closest point to a's, toward more clearance (flipped when
+    they overlap); None when the points coincide and there is no direction to move along."""
     gap = on_a - on_b
     length = np.linalg.norm(gap)
     if length < 1e-9:
-        return False
-    rows.append(d)
-    normals.append(gap / length * (1.0 if d >= 0 else -1.0))
-    return True
+        return None
+    return gap / length * (1.0 if d >= 0 else -1.0)

@@ -62,10 +62,6 @@ class Task:
         reference = target_arrays(self, target)
         return orientation_error(self.code, self.tool_axis, rotation, *reference)
 
-    def rows(self) -> int:
-        """How many task-space rows the baselines track: 3, 6 (pose) or 5 (two for the axis)."""
-        return {"position": 3, "pose": 6, "position+axis": 5}[self.kind]
-
 
 def as_target(target: Target | np.ndarray) -> Target:
     """A Target as is; a position [m] as the Target of that position alone."""

@@ -302,18 +302,17 @@ def _evaluate(
         _apply(world_R[s], world_p[s], capsule_b[s], ends[s, 1])
     npairs = pairs.shape[0]
     lower = np.empty(npairs)
+    has_obstacle = has_self = False  # a kind without pairs here cannot improve
     for k in range(npairs):
         a, b = pairs[k, 0], pairs[k, 1]
         gap = _segment_distance(ends[a, 0], ends[a, 1], ends[b, 0], ends[b, 1])
         lower[k] = gap - capsule_r[a] - capsule_r[b]
+        if pairs[k, 3] == 1:
+            has_self = True
+        else:
+            has_obstacle = True
     # Scalars, not a 2-array: this runs three times per BAORNN iteration.
     best_obstacle, best_self = static_min[0], static_min[1]
-    has_obstacle = has_self = False  # a kind without pairs here cannot improve
-    for k in range(npairs):
-        if pairs[k, 3] == 0:
-            has_obstacle = True
-        else:
-            has_self = True
     for k in np.argsort(lower):
         limit = -np.inf
         if has_obstacle:

@@ -28,7 +28,7 @@ class Obstacle:
         if not self.parts:
             raise GeometryError(f"obstacle {self.name!r}: has no convex parts")
         if not callable(self.pose):
-            check_pose(self.name, self.pose)
+            check_pose(f"obstacle {self.name!r}", self.pose)
 
     @property
     def moving(self) -> bool:
@@ -38,15 +38,16 @@ class Obstacle:
     def pose_at(self, t: float) -> np.ndarray:
         """The obstacle's pose (4×4, world) at time t [s]."""
         if callable(self.pose):
-            return check_pose(self.name, np.asarray(self.pose(t), dtype=float))
+            return check_pose(f"obstacle {self.name!r}", np.asarray(self.pose(t), dtype=float))
         return self.pose
 
 
-def check_pose(name: str, T: np.ndarray) -> np.ndarray:
-    """T if it is a finite 4×4 pose with a rotation; GeometryError naming obstacle `name`."""
+def check_pose(what: str, T: np.ndarray) -> np.ndarray:
+    """T if it is a finite 4×4 pose with a rotation; GeometryError that starts with `what`
+    (e.g. "obstacle 'box'")."""
     if T.shape != (4, 4) or not np.all(np.isfinite(T)):
-        raise GeometryError(f"obstacle {name!r}: pose must be a finite 4×4 matrix (got {T.shape})")
+        raise GeometryError(f"{what}: pose must be a finite 4×4 matrix (got {T.shape})")
     R = T[:3, :3]
     if not np.allclose(R @ R.T, np.eye(3), atol=1e-6) or np.linalg.det(R) < 0:
-        raise GeometryError(f"obstacle {name!r}: pose rotation is not a rotation matrix")
+        raise GeometryError(f"{what}: pose rotation is not a rotation matrix")
     return T

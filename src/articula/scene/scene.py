@@ -103,7 +103,7 @@ class Scene:
         self.broadphase = broadphase
         self.metric: Metric = metric
         self.link_names = [link.name for link in robot.links]
-        self.self_pairs = _link_pairs(self_pairs, self.link_names)
+        self.self_pairs = link_pairs(self_pairs, self.link_names, "self_pairs")
         geo = _Geometry()
         link_geoms = []
         for li, link in enumerate(robot.links):
@@ -166,6 +166,7 @@ class Scene:
                 self._static_min[kind_of[p]] = min(self._static_min[kind_of[p]], self._exact(p))
         self._dynamic = [p for p, fixed in enumerate(static) if not fixed]
         self._dynamic_kinds = [kind_of[p] for p in self._dynamic]
+        self._kinds_present = sorted(set(self._dynamic_kinds))  # kinds a query can lower
         self._dynamic_bounds = [self._bound_results[p] for p in self._dynamic]
         for p, fixed in enumerate(static):
             if fixed:
@@ -196,17 +197,12 @@ class Scene:
         for p, (li, oi) in enumerate(self._cell_of_pair[: self._n_obstacle_pairs]):
             if d[p] < best[li, oi]:
                 best[li, oi] = d[p]
-                if self.metric == "gjk":
-                    on_link[li, oi] = self._results[p].getNearestPoint1()
-                    on_obstacle[li, oi] = self._results[p].getNearestPoint2()
-                else:
-                    on_link[li, oi], on_obstacle[li, oi] = self._vertex_pair(p)
+                on_link[li, oi], on_obstacle[li, oi] = self._closest_points(p)
         return Witnesses(best, on_link, on_obstacle)
 
     def self_distances(self, q: Sequence[float] | np.ndarray) -> np.ndarray:
         """Signed distance [m] of every link pair in `self_pairs`, in its order."""
-        d = self._pair_distances(self.robot.check_q(q), 0.0, every_pair=True)
-        return self._self_minima(d)
+        return self._self_minima(self._pair_distances(self.robot.check_q(q), 0.0, True))
 
     def self_witnesses(self, q: Sequence[float] | np.ndarray) -> SelfWitnesses:
         """Self distances with the closest point on each link of each pair."""
@@ -217,11 +213,7 @@ class Scene:
             k = self._cell_of_pair[p][1]
             if d[p] < best[k]:
                 best[k] = d[p]
-                if self.metric == "gjk":
-                    on_a[k] = self._results[p].getNearestPoint1()
-                    on_b[k] = self._results[p].getNearestPoint2()
-                else:
-                    on_a[k], on_b[k] = self._vertex_pair(p)
+                on_a[k], on_b[k] = self._closest_points(p)
         return SelfWitnesses(best, on_a, on_b)
 
     def self_clearance(self, q: Sequence[float] | np.ndarray) -> float:
@@ -333,14 +325,13 @@ class Scene:
         pin.updateGeometryPlacements(model, data, exact_model, exact_data)
         requests, results, dynamic = self._requests, self._results, self._dynamic
         best = list(self._static_min)  # [obstacles, self]
-        kinds = self._dynamic_kinds
-        present = [kind in kinds for kind in (0, 1)]
+        kinds, present = self._dynamic_kinds, self._kinds_present
         # Visit pairs by increasing lower bound; none after the first bound above the best
         # exact distance so far of every kind can lower a minimum.
         for i in sorted(range(len(lower)), key=lower.__getitem__):
             kind = kinds[i]
             if lower[i] >= best[kind]:
-                if all(lower[i] >= b for b, here in zip(best, present, strict=True) if here):
+                if all(lower[i] >= best[k] for k in present):
                     break
                 continue
             p = dynamic[i]
@@ -364,6 +355,12 @@ class Scene:
         np.minimum.at(out, self._self_cells, pair_distances[self._n_obstacle_pairs :])
         return out
 
+    def _closest_points(self, p: int) -> tuple[np.ndarray, np.ndarray]:
+        """The closest points (world) of pair p's two shapes, by the scene's metric."""
+        if self.metric == "gjk":
+            return self._results[p].getNearestPoint1(), self._results[p].getNearestPoint2()
+        return self._vertex_pair(p)
+
     def _vertex_pair(self, p: int) -> tuple[np.ndarray, np.ndarray]:
         """Closest vertex pair (world) of pair p, the book's Sect. 1.3.3 formula."""
         pair = self._geo.exact.collisionPairs[p]
@@ -383,16 +380,21 @@ class Scene:
         return float(np.linalg.norm(on_a - on_b))
 
 
-def _link_pairs(pairs: Sequence[tuple[str, str]], links: list[str]) -> tuple[tuple[int, int], ...]:
-    """Link pairs by name as sorted index pairs, each once; ConfigError for an unknown link."""
+def link_pairs(
+    pairs: Sequence[Sequence[str]], links: list[str], field: str
+) -> tuple[tuple[int, int], ...]:
+    """Link pairs by name as sorted index pairs into `links`, each once; ConfigError naming
+    `field` for an entry that is not two different links of the list."""
     out = set()
-    for a, b in pairs:
+    for pair in pairs:
+        if len(pair) != 2:
+            raise ConfigError(field, f"each entry needs two link names (got {list(pair)})")
+        a, b = pair
         for name in (a, b):
             if name not in links:
-                raise ConfigError("self_pairs", f"no link {name!r} with collision shapes; "
+                raise ConfigError(field, f"no link {name!r} with collision shapes; "
                                   f"the links are {links}")  # fmt: skip
         if a == b:
-            raise ConfigError("self_pairs", f"a link cannot collide with itself ({a!r})")
-        ia, ib = sorted((links.index(a), links.index(b)))
-        out.add((ia, ib))
+            raise ConfigError(field, f"a link cannot collide with itself ({a!r})")
+        out.add(tuple(sorted((links.index(a), links.index(b)))))
     return tuple(sorted(out))

@@ -16,9 +16,8 @@ from typing import Literal
 
 import numpy as np
 
-from articula.errors import ConfigError
 from articula.robots.model import RobotModel
-from articula.scene.scene import Scene
+from articula.scene.scene import Scene, link_pairs
 
 Reason = Literal["adjacent", "never close", "always touching", "allowed"]
 SAMPLES = 1000  # random configurations; MoveIt's assistant defaults to 10,000 collision checks
@@ -53,15 +52,9 @@ def self_collision_matrix(
         The pairs to check, in link order, and the skipped ones with their reason.
     """
     names = [link.name for link in robot.links]
-    skipped: dict[tuple[str, str], Reason] = {}
-    for pair in allow_pairs:
-        if len(pair) != 2:
-            raise ConfigError("allow_pairs", f"each entry needs two link names (got {pair})")
-        a, b = pair
-        for name in (a, b):
-            if name not in names:
-                raise ConfigError("allow_pairs", f"no link {name!r}; the links are {names}")
-        skipped[_ordered(names, a, b)] = "allowed"
+    skipped: dict[tuple[str, str], Reason] = {
+        (names[a], names[b]): "allowed" for a, b in link_pairs(allow_pairs, names, "allow_pairs")
+    }
     joint = {link.name: robot.model.frames[link.frame_id].parentJoint for link in robot.links}
     parents = robot.model.parents
     candidates = []
@@ -85,10 +78,3 @@ def self_collision_matrix(
                 skipped[pair] = "always touching"
     checked = tuple(pair for pair in itertools.combinations(names, 2) if pair not in skipped)
     return SelfCollisionMatrix(checked, skipped)
-
-
-def _ordered(names: list[str], a: str, b: str) -> tuple[str, str]:
-    """(a, b) in link order; ConfigError for a link paired with itself."""
-    if a == b:
-        raise ConfigError("allow_pairs", f"a link cannot collide with itself ({a!r})")
-    return (a, b) if names.index(a) < names.index(b) else (b, a)
