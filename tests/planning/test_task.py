@@ -129,3 +129,10 @@ def test_bad_orientation_keys_are_refused(extra, message):
                   radius=0.1, period=5.0)  # fmt: skip
     with pytest.raises(ConfigError, match=message):
         parse_model(TrajectorySpec, circle | extra, "trajectory")
+
+
+def test_a_wrong_count_of_waypoint_quaternions_names_quaternions():
+    spec = TrajectorySpec(type="waypoints", points=[[0.4, 0, 0.5], [0.4, 0.2, 0.5]],
+                          times=[0.0, 2.0], quaternions=[[1, 0, 0, 0]])  # fmt: skip
+    with pytest.raises(ConfigError, match=r"trajectory\.quaternions: needs 2 orientations"):
+        make_targets(spec, Path("."))

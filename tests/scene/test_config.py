@@ -4,6 +4,7 @@ an obstacle at constant speed), give the distances written out by hand."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -182,3 +183,19 @@ def test_robot_decompose_of_links_without_meshes_changes_nothing(tmp_path, write
     path = write_toml({"robot": {"urdf": "turn.urdf", "decompose": True}}, "scene.toml")
     scene, _ = build_scene(load_scene_spec(load_toml(path)), tmp_path)
     assert [s.kind for link in scene.robot.links for s in link.shapes] == ["sphere", "sphere"]
+
+
+@pytest.mark.parametrize("self_collision", [True, False])
+def test_an_unknown_link_in_allow_pairs_is_an_error_even_with_self_collision_off(self_collision):
+    robot = {"builtin": "iiwa14", "self_collision": self_collision,
+             "allow_pairs": [["iiwa_link_1", "gripper"]]}  # fmt: skip
+    with pytest.raises(ConfigError, match=r"robot\.allow_pairs.*no link 'gripper'"):
+        build_scene(load_scene_spec({"robot": robot}), Path("."))
+
+
+def test_self_collision_from_the_robot_table_checks_the_matrix_pairs():
+    robot = {"builtin": "iiwa14", "self_collision": True,
+             "allow_pairs": [["iiwa_link_7", "iiwa_link_5"]]}  # fmt: skip
+    scene, _ = build_scene(load_scene_spec({"robot": robot}), Path("."))
+    assert ("iiwa_link_0", "iiwa_link_5") in scene.self_pair_names
+    assert ("iiwa_link_5", "iiwa_link_7") not in scene.self_pair_names

@@ -218,7 +218,8 @@ def make_targets(spec: TrajectorySpec, base_dir: Path) -> TargetPath:
             each = [rotation_from(r, None) for r in spec.rpys or []] + [
                 rotation_from(None, quaternion) for quaternion in spec.quaternions or []
             ]
-            rotations = WaypointRotations.create(each, spec.times or [])
+            field = "rpys" if spec.rpys is not None else "quaternions"
+            rotations = WaypointRotations.create(each, spec.times or [], field)
         axis = None if spec.axis is None else axis_direction(spec.axis)
         return TargetPath(path, rotations, axis, spec.cone)
 

@@ -23,11 +23,14 @@ class WaypointRotations:
     slerp: Slerp
 
     @classmethod
-    def create(cls, rotations: Sequence[np.ndarray], times: Sequence[float]) -> WaypointRotations:
-        """From one 3×3 rotation per time; times as the waypoints' (checked there)."""
+    def create(
+        cls, rotations: Sequence[np.ndarray], times: Sequence[float], field: str = "rpys"
+    ) -> WaypointRotations:
+        """From one 3×3 rotation per time; times as the waypoints' (checked there); a count
+        that differs is a ConfigError naming `field`."""
         t = np.asarray(times, dtype=float)
         if len(rotations) != len(t):
-            raise ConfigError("rpys", f"needs {len(t)} orientations, one per point")
+            raise ConfigError(field, f"needs {len(t)} orientations, one per point")
         return cls(t, Slerp(t, Rotation.from_matrix(np.asarray(rotations))))
 
     def __call__(self, t: float) -> np.ndarray:

@@ -16,7 +16,7 @@ from articula.geometry.shapes import ConvexShape, box, capsule, cylinder, sphere
 from articula.limits import MAX_DECOMPOSE_VERTICES, MAX_LENGTH, MAX_LINKS, MAX_SCALE, MIN_SCALE
 from articula.robots.model import RobotModel
 from articula.scene.obstacles import Obstacle
-from articula.scene.scene import Metric, Scene
+from articula.scene.scene import Metric, Scene, link_pairs
 from articula.scene.self_collision import (
     MARGIN,
     SAMPLES,
@@ -151,6 +151,8 @@ def build_scene(
             obstacles.append(_obstacle(o, i, base_dir))
         except GeometryError as exc:
             raise ConfigError(f"obstacles[{i}] ({o.name or f'obstacle_{i}'})", str(exc)) from None
+    names = [link.name for link in robot.links]
+    link_pairs(r.allow_pairs, names, "robot.allow_pairs")  # a typo is an error even when off
     self_pairs = robot_self_collision(spec, robot).checked if r.self_collision else ()
     return Scene(robot, obstacles, broadphase, metric, self_pairs), q0
 
