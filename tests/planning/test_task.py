@@ -136,3 +136,33 @@ def test_a_wrong_count_of_waypoint_quaternions_names_quaternions():
                           times=[0.0, 2.0], quaternions=[[1, 0, 0, 0]])  # fmt: skip
     with pytest.raises(ConfigError, match=r"trajectory\.quaternions: needs 2 orientations"):
         make_targets(spec, Path("."))
+
+
+@pytest.mark.parametrize(
+    ("header", "rows"),
+    [("t,x,y,z,roll,pitch,yaw", ["0,0.4,0,0.5,0,0,0", "2,0.4,0.2,0.5,0,0,1.2"]),
+     ("t,x,y,z,qw,qx,qy,qz",
+      ["0,0.4,0,0.5,1,0,0,0", f"2,0.4,0.2,0.5,{np.cos(0.6)},0,0,{np.sin(0.6)}"])],
+    ids=["rpy", "quaternion"],
+)  # fmt: skip
+def test_a_csv_trajectory_carries_an_orientation_per_row(tmp_path, header, rows):
+    (tmp_path / "path.csv").write_text("\n".join([header, *rows]) + "\n")
+    targets = make_targets(TrajectorySpec(type="csv", path="path.csv"), tmp_path)
+    assert np.allclose(targets(1.0).position, [0.4, 0.1, 0.5])
+    assert np.allclose(targets(1.0).rotation, Rotation.from_rotvec([0, 0, 0.6]).as_matrix())
+
+
+def test_a_csv_trajectory_without_orientation_columns_has_none(tmp_path):
+    (tmp_path / "path.csv").write_text("t,x,y,z\n0,0.4,0,0.5\n1,0.4,0.1,0.5\n")
+    assert make_targets(TrajectorySpec(type="csv", path="path.csv"), tmp_path)(0.5).rotation is None
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [("t,x,y,z,roll,pitch\n0,0,0,0,0,0\n1,1,0,0,0,0\n", "optionally with roll, pitch, yaw"),
+     ("t,x,y,z,roll,pitch,yaw\n0,0,0,0,0,nan,0\n1,1,0,0,0,0,0\n", "must be finite")],
+)  # fmt: skip
+def test_bad_csv_orientation_columns_are_refused(tmp_path, text, message):
+    (tmp_path / "path.csv").write_text(text)
+    with pytest.raises(ConfigError, match=rf"trajectory\.path.*{message}"):
+        make_targets(TrajectorySpec(type="csv", path="path.csv"), tmp_path)

@@ -19,6 +19,7 @@ from articula.planning.target_path import (
     TargetPath,
     WaypointRotations,
     axis_direction,
+    csv_rotations,
     fixed_rotation,
     rotation_from,
 )
@@ -220,6 +221,8 @@ def make_targets(spec: TrajectorySpec, base_dir: Path) -> TargetPath:
             ]
             field = "rpys" if spec.rpys is not None else "quaternions"
             rotations = WaypointRotations.create(each, spec.times or [], field)
+        if spec.type == "csv":
+            rotations = csv_rotations(resolve_path(base_dir, spec.path or ""))
         axis = None if spec.axis is None else axis_direction(spec.axis)
         return TargetPath(path, rotations, axis, spec.cone)
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from scipy.spatial.transform import Rotation, Slerp
@@ -12,6 +13,7 @@ from scipy.spatial.transform import Rotation, Slerp
 from articula.errors import ConfigError
 from articula.geometry.poses import pose
 from articula.planning.task import Target, unit
+from articula.planning.trajectories import read_csv
 
 
 @dataclass(frozen=True)
@@ -76,6 +78,23 @@ def rotation_from(rpy: Sequence[float] | None, quaternion: Sequence[float] | Non
     if rpy is None:
         raise ConfigError("rpy", "give rpy = [roll, pitch, yaw] or quaternion = [w, x, y, z]")
     return pose((0.0, 0.0, 0.0), rpy)[:3, :3]  # the URDF's convention, as for obstacles
+
+
+def csv_rotations(path: Path) -> WaypointRotations | None:
+    """The orientations of a trajectory CSV's rows (roll, pitch, yaw or qw, qx, qy, qz
+    columns), or None when it has none."""
+    data = read_csv(path)
+    names = data.dtype.names or ()
+    columns = [n for n in names if n not in ("t", "x", "y", "z")]
+    if columns and not all(np.all(np.isfinite(data[n])) for n in columns):
+        raise ConfigError("path", f"{path}: orientation columns {columns} must be finite numbers")
+    if "roll" in names:
+        rotations = [rotation_from((r["roll"], r["pitch"], r["yaw"]), None) for r in data]
+    elif "qw" in names:
+        rotations = [rotation_from(None, (r["qw"], r["qx"], r["qy"], r["qz"])) for r in data]
+    else:
+        return None
+    return WaypointRotations.create(rotations, data["t"], "path")
 
 
 def axis_direction(axis: Sequence[float]) -> np.ndarray:

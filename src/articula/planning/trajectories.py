@@ -80,22 +80,36 @@ class Waypoints:
 
     @classmethod
     def from_csv(cls, path: Path) -> Waypoints:
-        """Waypoints from a CSV file with the header t,x,y,z."""
-        if not Path(path).is_file():
-            raise ConfigError("path", f"{path}: file not found")
-        try:
-            data = np.genfromtxt(path, delimiter=",", names=True)
-        except ValueError as exc:
-            raise ConfigError("path", f"{path}: not a numeric CSV ({exc})") from None
-        names = data.dtype.names or ()
-        if set(names) != {"t", "x", "y", "z"}:
-            raise ConfigError("path", f"{path}: needs columns t, x, y, z (got {names})")
-        data = np.atleast_1d(data)
+        """Waypoints from a CSV file with the header t,x,y,z (and optionally an orientation
+        per row, see read_csv)."""
+        data = read_csv(path)
         return cls.create(np.column_stack([data["x"], data["y"], data["z"]]), data["t"])
 
     def __call__(self, t: float) -> np.ndarray:
         """Reference point [m] at time t [s]."""
         return np.array([np.interp(t, self.times, self.points[:, i]) for i in range(3)])
+
+
+CSV_ORIENTATIONS = ({"roll", "pitch", "yaw"}, {"qw", "qx", "qy", "qz"})
+
+
+def read_csv(path: Path) -> np.ndarray:
+    """The rows of a trajectory CSV as a structured array: columns t, x, y, z [s, m], and
+    optionally roll, pitch, yaw [rad] or qw, qx, qy, qz (the tool's orientation per row)."""
+    if not Path(path).is_file():
+        raise ConfigError("path", f"{path}: file not found")
+    try:
+        data = np.genfromtxt(path, delimiter=",", names=True)
+    except ValueError as exc:
+        raise ConfigError("path", f"{path}: not a numeric CSV ({exc})") from None
+    names = set(data.dtype.names or ())
+    if not any(names in ({"t", "x", "y", "z"}, {"t", "x", "y", "z"} | o) for o in CSV_ORIENTATIONS):
+        raise ConfigError(
+            "path",
+            f"{path}: needs columns t, x, y, z, optionally with roll, pitch, yaw or qw, qx, qy, "
+            f"qz (got {sorted(names)})",
+        )
+    return np.atleast_1d(data)
 
 
 def rectangle(vertices: Sequence[Sequence[float]], period: float) -> Waypoints:
