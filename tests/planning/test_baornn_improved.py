@@ -64,10 +64,23 @@ def test_improved_beats_the_faithful_baornn_with_a_penalty_on_every_seed(objecti
         assert b.clearance.min() > objective.d_min
 
 
+def test_short_antennae_refine_what_the_long_ones_overshoot(objective):
+    # short_antenna = 1 is the variant without change 4: every pair as long as λ_k.
+    q0 = np.zeros(ROBOT.nq)
+    for seed in (0, 1, 2):
+        errors = {}
+        for short in (1.0, 0.25):
+            params = PARAMS.model_copy(update={"short_antenna": short})
+            planner = ImprovedBaornn(objective, params, np.random.default_rng(seed))
+            errors[short] = rms_after(track(planner, CIRCLE, q0, DT, 6.0), 3.0)
+        assert errors[0.25] < 0.7 * errors[1.0], (seed, errors)
+
+
 @pytest.mark.parametrize(
     ("kwargs", "field"),
-    [({"pairs": 0}, "ImprovedParams.pairs"), ({"c1": -1.0}, "ImprovedParams.c1")],
-)
+    [({"pairs": 0}, "ImprovedParams.pairs"), ({"c1": -1.0}, "ImprovedParams.c1"),
+     ({"short_antenna": 0.0}, "ImprovedParams.short_antenna")],
+)  # fmt: skip
 def test_bad_params_name_the_class_and_field(kwargs, field):
     with pytest.raises(ConfigError) as exc:
         ImprovedParams(**kwargs)

@@ -74,8 +74,14 @@ def iterations(
 
 
 @jit()
+def antenna_scale(pair: int, short: float) -> float:
+    """Length of antenna pair `pair` relative to λ_k: every second pair is short."""
+    return 1.0 if pair % 2 == 0 else short
+
+
+@jit()
 def improved_iterations(
-    q, g, x_ref, orient, draws, c1, c2, lambda_weight, beta, d_min, lower, upper,
+    q, g, x_ref, orient, draws, c1, c2, short, lambda_weight, beta, d_min, lower, upper,
     arrays, kinematics, static_min,
 ):  # fmt: skip
     """baornn-improved's iterations (planning/baornn_improved.py), one per draws[k], an
@@ -91,15 +97,16 @@ def improved_iterations(
         best_q, best_g = q, g
         for j in range(directions.shape[1]):
             b = np.ascontiguousarray(directions[:, j])
-            q_left, g_left = _project_and_value(q + lam * b, q, g, x_ref, orient,
+            scale = antenna_scale(j, short)
+            q_left, g_left = _project_and_value(q + scale * lam * b, q, g, x_ref, orient,
                                                 lambda_weight, beta, d_min, lower, upper,
                                                 arrays, static_min)  # fmt: skip
-            q_right, g_right = _project_and_value(q - lam * b, q, g, x_ref, orient, lambda_weight,
-                                                  beta, d_min, lower, upper,
+            q_right, g_right = _project_and_value(q - scale * lam * b, q, g, x_ref, orient,
+                                                  lambda_weight, beta, d_min, lower, upper,
                                                   arrays, static_min)  # fmt: skip
             evaluations += 2
             if math.isfinite(g_left) and math.isfinite(g_right):
-                gradient += (g_left - g_right) * b
+                gradient += (g_left - g_right) / scale * b
             if g_left < best_g:
                 best_q, best_g = q_left, g_left
             if g_right < best_g:

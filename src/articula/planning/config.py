@@ -94,8 +94,9 @@ class PlannerSpec(StrictModel):
     """[planner]: the method and its parameters; keys a method does not use are ignored.
 
     BAORNN (both): lambda_weight Λ, beta β (Eq. 1.11), d_min (1.12), c1, c2 (1.23-1.24),
-    iterations_per_step, seed; baornn-improved also `pairs`. Baselines: gain K [1/s];
-    pinv/dls: repulsion η, influence [m], damping μ [m] (dls); qp: influence, safety [m].
+    iterations_per_step, seed; baornn-improved also `pairs` and `short_antenna`. Baselines:
+    gain K [1/s]; pinv/dls: repulsion η, influence [m], damping μ [m] (dls); qp: influence,
+    safety [m].
     `seed` is also accepted at the top of a plan config, where it wins (see PlanConfig).
     """
 
@@ -111,6 +112,7 @@ class PlannerSpec(StrictModel):
     c1: Positive = 0.5
     c2: Positive = 0.5
     pairs: Annotated[int, Field(ge=1, le=64)] = 3
+    short_antenna: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.25
     gain: NonNegative = 20.0
     damping: NonNegative = 0.02
     repulsion: NonNegative = 0.02
@@ -167,6 +169,7 @@ def _planner(spec: PlannerSpec, scene: Scene, seed: int) -> Planner:
         return Baornn(objective, params, rng, rate)
     if spec.method == "baornn-improved":
         improved = ImprovedParams(c1=spec.c1, c2=spec.c2, pairs=spec.pairs,
+                                  short_antenna=spec.short_antenna,
                                   iterations_per_step=spec.iterations_per_step)  # fmt: skip
         return ImprovedBaornn(objective, improved, rng, rate)
     if spec.method == "qp":

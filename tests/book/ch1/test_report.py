@@ -25,8 +25,9 @@ def _made_up() -> tuple[dict, dict]:
 
 def test_the_markdown_formats_made_up_numbers_without_running_anything(section):
     metrics, table = _made_up()
-    settings = {"d_min": 0.002, "pairs": 3, "gain": 20.0, "repulsion": 0.02, "influence": 0.15,
-                "safety": 0.03, "dt": 0.01, "iterations_per_step": 10, "c1": 0.3, "c2": 0.5,
+    settings = {"d_min": 0.002, "pairs": 3, "short_antenna": 0.25, "gain": 20.0,
+                "repulsion": 0.02, "influence": 0.15, "safety": 0.03, "dt": 0.01,
+                "iterations_per_step": 10, "c1": 0.3, "c2": 0.5,
                 "beta": 1.0, "settle": 5.0}  # fmt: skip
     md = report.markdown(Ch1Results(metrics, {}, {}, settings), table, full=False)
     assert "d_min = 0.002 m" in md and "K = 20/s" in md

@@ -73,7 +73,8 @@ def _comparison_lines(table: Table, full: bool, p: Mapping[str, Any]) -> list[st
         "### All methods on all scenes",
         "",
         f"BAORNN rows use the scene's book Λ and d_min = {p['d_min']:g} m ({seeds}); "
-        f"baornn-improved uses {p['pairs']} antenna pairs per iteration. pinv/dls: resolved-rate "
+        f"baornn-improved uses {p['pairs']} antenna pairs per iteration, every second one "
+        f"{p['short_antenna']:g} as long. pinv/dls: resolved-rate "
         f"control (K = {p['gain']:g}/s) with a null-space FIRAS repulsion (η = "
         f"{p['repulsion']:g}, influence {p['influence']:g} m); qp: NEO-style velocity dampers "
         f"(influence {p['influence']:g} m, safety {p['safety']:g} m) solved by daqp. The "
