@@ -56,3 +56,19 @@ def test_clearance_rows_keep_only_the_cells_within_the_influence_distance():
     assert rows.gradient.shape == (3, ROBOT.nq)
     none = clearance_rows(scene, Q_BENT, 0.0, 0.5 * ordered[0])
     assert none.distance.shape == (0,) and none.gradient.shape == (0, ROBOT.nq)
+
+
+def test_self_pair_rows_match_finite_differences_of_self_distances():
+    from articula.scene import Scene
+
+    pairs = [("iiwa_link_0", "iiwa_link_5"), ("iiwa_link_1", "iiwa_link_6"),
+             ("iiwa_link_2", "iiwa_link_7")]  # fmt: skip
+    scene = Scene(ROBOT, [], self_pairs=pairs)
+    q = np.array([0.2, 1.6, 0.1, 1.9, 0.3, 1.2, 0.0])  # folded: the wrist near the base
+    rows = clearance_rows(scene, q, 0.0, 0.4)
+    d = scene.self_distances(q)
+    assert rows.self_pair.all() and len(rows.distance) == np.sum(d < 0.4) >= 2
+    fd = central_differences(lambda qq: scene.self_distances(qq), q, 1e-6)
+    for distance, grad in zip(rows.distance, rows.gradient, strict=True):
+        (k,) = np.flatnonzero(d == distance)
+        assert np.allclose(grad, fd[k], atol=1e-6), (scene.self_pair_names[k], grad, fd[k])

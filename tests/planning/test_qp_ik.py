@@ -47,14 +47,15 @@ def test_qp_dampers_keep_clearance_with_an_obstacle_across_the_approach():
 
 
 def test_qp_counts_the_periods_without_a_solution_and_stays_put(monkeypatch):
-    solve = qp_ik.qpsolvers.solve_qp
+    solve = qp_ik.daqp.solve
     calls = {"n": 0}
 
     def every_third_fails(*args, **kwargs):
         calls["n"] += 1
-        return None if calls["n"] % 3 == 0 else solve(*args, **kwargs)
+        x, value, status, info = solve(*args, **kwargs)
+        return x, value, -1 if calls["n"] % 3 == 0 else status, info  # -1: infeasible
 
-    monkeypatch.setattr(qp_ik.qpsolvers, "solve_qp", every_third_fails)
+    monkeypatch.setattr(qp_ik.daqp, "solve", every_third_fails)
     planner = QpIk(FREE, DT)
     q = np.zeros(ROBOT.nq)
     moved = []

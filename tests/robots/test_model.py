@@ -203,7 +203,7 @@ def test_iiwa_jacobian_at_home_by_hand(iiwa):
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
-def test_point_jacobian_matches_finite_differences_of_a_point_fixed_to_a_link(iiwa, seed):
+def test_directional_gradients_match_finite_differences_of_a_point_fixed_to_a_link(iiwa, seed):
     rng = np.random.default_rng(seed)
     q = rng.uniform(0.8 * iiwa.lower, 0.8 * iiwa.upper)
     local = rng.normal(scale=0.1, size=3)  # a point in the link frame, off its origin
@@ -216,7 +216,8 @@ def test_point_jacobian_matches_finite_differences_of_a_point_fixed_to_a_link(ii
             return T[:3, :3] @ local + T[:3, 3]
 
         p = world_point(q)
-        J = iiwa.point_jacobian(q, link.frame_id, p)
+        # Along the three axes the rows are the point's Jacobian.
+        J = iiwa.directional_gradients(q, [link.frame_id] * 3, np.array([p] * 3), np.eye(3))
         assert J.shape == (3, iiwa.nq)
         assert np.allclose(J, central_differences(world_point, q, 1e-6), atol=1e-7), link.name
         # Joints after the link's own joint (index j moves q[j - 1]) do not move the point.

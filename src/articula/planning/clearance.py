@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,39 +30,44 @@ def clearance_rows(scene: Scene, q: np.ndarray, t: float, influence: float) -> C
     ∇d = n·(J_a − J_b) with n from b's closest point to a's.
     """
     robot = scene.robot
-    # Per row: its distance, the unit normal n, and the points whose motion moves it, each as
-    # (frame, world point, +1 for link a | −1 for link b).
-    rows: list[tuple[float, np.ndarray, list[tuple[int, np.ndarray, float]]]] = []
-    w = scene.witnesses(q, t)
+    distances, normals, flags = [], [], []
+    frames, points, row_of = [], [], []  # each point that moves a row, with its sign below
+    signs = []
+    w, s = scene.witnesses_within(q, t, influence)
     for li, oi in zip(*np.nonzero(w.distance < influence), strict=True):
         n = _normal(w.distance[li, oi], w.on_link[li, oi], w.on_obstacle[li, oi])
         if n is not None:
-            on_link = [(robot.links[li].frame_id, w.on_link[li, oi], 1.0)]
-            rows.append((w.distance[li, oi], n, on_link))
-    n_obstacle_rows = len(rows)
-    if scene.self_pairs:
-        s = scene.self_witnesses(q)
-        for k in np.nonzero(s.distance < influence)[0]:
-            n = _normal(s.distance[k], s.on_a[k], s.on_b[k])
-            if n is not None:
-                a, b = scene.self_pairs[k]
-                ends = [(robot.links[a].frame_id, s.on_a[k], 1.0),
-                        (robot.links[b].frame_id, s.on_b[k], -1.0)]  # fmt: skip
-                rows.append((s.distance[k], n, ends))
-    terms = [term for _, _, row_terms in rows for term in row_terms]
-    jacobians = iter(robot.point_jacobians(q, [f for f, _, _ in terms], [p for _, p, _ in terms]))
-    grads = [n @ sum(sign * next(jacobians) for _, _, sign in row_terms)
-             for _, n, row_terms in rows]  # fmt: skip
-    flags = np.arange(len(rows)) >= n_obstacle_rows
-    distances = np.array([d for d, _, _ in rows])
-    return ClearanceRows(distances, np.array(grads).reshape(len(rows), robot.nq), flags)
+            row_of.append(len(distances))
+            frames.append(robot.links[li].frame_id)
+            points.append(w.on_link[li, oi])
+            signs.append(1.0)
+            distances.append(w.distance[li, oi])
+            normals.append(n)
+            flags.append(False)
+    for k in np.nonzero(s.distance < influence)[0]:
+        n = _normal(s.distance[k], s.on_a[k], s.on_b[k])
+        if n is not None:
+            a, b = scene.self_pairs[k]
+            row_of += [len(distances), len(distances)]
+            frames += [robot.links[a].frame_id, robot.links[b].frame_id]
+            points += [s.on_a[k], s.on_b[k]]
+            signs += [1.0, -1.0]  # link b moving along n brings the two closer
+            distances.append(s.distance[k])
+            normals.append(n)
+            flags.append(True)
+    gradient = np.zeros((len(distances), robot.nq))
+    if frames:
+        directions = np.array(normals)[row_of] * np.array(signs)[:, None]
+        terms = robot.directional_gradients(q, frames, np.array(points), directions)
+        np.add.at(gradient, row_of, terms)
+    return ClearanceRows(np.array(distances), gradient, np.array(flags, dtype=bool))
 
 
 def _normal(d: float, on_a: np.ndarray, on_b: np.ndarray) -> np.ndarray | None:
     """The unit normal from b's closest point to a's, toward more clearance (flipped when
     they overlap); None when the points coincide and there is no direction to move along."""
     gap = on_a - on_b
-    length = np.linalg.norm(gap)
+    length = math.sqrt(gap @ gap)
     if length < 1e-9:
         return None
-    return gap / length * (1.0 if d >= 0 else -1.0)
+    return gap * ((1.0 if d >= 0 else -1.0) / length)

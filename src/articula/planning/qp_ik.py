@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import daqp
 import numpy as np
-import qpsolvers
 from pydantic import model_validator
 
 from articula.planning.clearance import clearance_rows
@@ -80,29 +80,44 @@ class QpIk:
         J, v = task_rows(robot, q, self.task, target, self._previous, self.dt, p.gain)
         self._previous = target
         m = J.shape[0]  # task rows, each with its slack
-        P = np.diag(np.r_[np.full(n, p.joint_weight), np.full(m, p.slack_weight)])
-        A = np.hstack([J, np.eye(m)])
-        G_rows, h_rows = [], []
-        if self.scene.has_clearance:
-            rows = clearance_rows(self.scene, q, t, p.influence)
-            for d, grad, itself in zip(rows.distance, rows.gradient, rows.self_pair, strict=True):
-                if not np.any(grad):
-                    continue  # a world-fixed link: no joint changes d, so no row can help
-                # −∇d·q̇ ≤ ξ (d − d_s)/(d_i − d_s): approach no faster than the damper allows.
-                safety = p.self_safety if itself else p.safety
-                G_rows.append(np.r_[-grad, np.zeros(m)])
-                h_rows.append(p.damper_gain * (d - safety) / (p.influence - safety))
-        for j in range(n):
-            for sign, room in ((1.0, robot.upper[j] - q[j]), (-1.0, q[j] - robot.lower[j])):
-                if room < p.limit_influence:
-                    row = np.zeros(n + m)
-                    row[j] = sign
-                    G_rows.append(row)
-                    span = p.limit_influence - p.limit_safety
-                    h_rows.append(p.damper_gain * (room - p.limit_safety) / span)
+        dampers, h = self._clearance_dampers(q, t)
+        # Joint-limit dampers: the same law on the room left to each limit [rad].
+        up = robot.model.upperPositionLimit - q
+        down = q - robot.model.lowerPositionLimit
+        near_up = np.flatnonzero(up < p.limit_influence)
+        near_down = np.flatnonzero(down < p.limit_influence)
+        span = p.limit_influence - p.limit_safety
+        rooms = np.r_[up[near_up], down[near_down]]
+        k = len(dampers) + rooms.size  # inequality rows
+        # daqp's layout: box bounds on (q̇, δ), then G x ≤ h, then J q̇ + δ = v (sense 5).
+        rows = np.zeros((k + m, n + m))
+        rows[: len(dampers), :n] = dampers
+        limit_rows = rows[len(dampers) : k]
+        limit_rows[np.arange(near_up.size), near_up] = 1.0
+        limit_rows[near_up.size + np.arange(near_down.size), near_down] = -1.0
+        rows[k:, :n] = J
+        rows[k:, n:] = np.eye(m)
         limit = p.speed_scale * np.where(robot.velocity_limit > 0, robot.velocity_limit, 1e3)
         bound = np.r_[limit, np.full(m, 1e3)]
-        G = np.array(G_rows) if G_rows else None
-        h = np.array(h_rows) if h_rows else None
-        solution = qpsolvers.solve_qp(P, np.zeros(n + m), G, h, A, v, -bound, bound, solver="daqp")
-        return None if solution is None else solution[:n]
+        upper = np.r_[bound, h, p.damper_gain * (rooms - p.limit_safety) / span, v]
+        lower = np.full(upper.size, -1e30)
+        lower[: n + m] = -bound
+        sense = np.zeros(upper.size, dtype=np.intc)
+        sense[n + m + k :] = 5  # equality rows
+        weights = np.r_[np.full(n, p.joint_weight), np.full(m, p.slack_weight)]
+        solution, _, status, _ = daqp.solve(np.diag(weights), np.zeros(n + m), rows, upper,
+                                            lower, sense)  # fmt: skip
+        return solution[:n] if status > 0 else None
+
+    def _clearance_dampers(self, q: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """(−∇d rows, their bounds) of the velocity dampers on every distance within the
+        influence distance: −∇d·q̇ ≤ ξ (d − d_s)/(d_i − d_s), approach no faster than that."""
+        p, n = self.params, self.scene.robot.nq
+        if not self.scene.has_clearance:
+            return np.zeros((0, n)), np.zeros(0)
+        rows = clearance_rows(self.scene, q, t, p.influence)
+        # A world-fixed link: no joint changes its d, so no row can help.
+        moving = np.any(rows.gradient != 0.0, axis=1)
+        safety = np.where(rows.self_pair[moving], p.self_safety, p.safety)
+        h = p.damper_gain * (rows.distance[moving] - safety) / (p.influence - safety)
+        return -rows.gradient[moving], h

@@ -227,31 +227,27 @@ class RobotModel:
             self.model, self.data, arr, self.ee_frame_id, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
         ).copy()
 
-    def point_jacobian(self, q: np.ndarray, frame_id: int, point: np.ndarray) -> np.ndarray:
-        """3×nq Jacobian of a world point [m] moving rigidly with frame `frame_id`."""
-        return self.point_jacobians(q, [frame_id], [point])[0]
+    def directional_gradients(
+        self, q: np.ndarray, frame_ids: Sequence[int], points: np.ndarray, directions: np.ndarray
+    ) -> np.ndarray:
+        """Rows n_k·J_k (k × nq): how fast world point k [m], moving rigidly with frame
+        frame_ids[k], moves along direction n_k per unit joint velocity; each joint's Jacobian
+        is computed once.
 
-    def point_jacobians(
-        self, q: np.ndarray, frame_ids: Sequence[int], points: Sequence[np.ndarray]
-    ) -> list[np.ndarray]:
-        """3×nq Jacobians of world points [m], each moving rigidly with its frame; the joint
-        Jacobians are computed once for all of them.
-
-        v_p = v_o + ω × (p − o) at the parent joint's origin o, in world axes.
+        n·v_p = n·v_o + ω·((p − o) × n) at the parent joint's origin o, in world axes.
         """
         pin.computeJointJacobians(self.model, self.data, q)
-        out = []
-        for frame_id, point in zip(frame_ids, points, strict=True):
-            joint = self.model.frames[frame_id].parentJoint
-            J = pin.getJointJacobian(
-                self.model, self.data, joint, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-            )
-            out.append(J[:3] - _skew(point - self.data.oMi[joint].translation) @ J[3:])
-        return out
-
-
-def _skew(v: np.ndarray) -> np.ndarray:
-    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+        joints = [self.model.frames[f].parentJoint for f in frame_ids]
+        unique = sorted(set(joints))
+        frame = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+        stack = np.array([pin.getJointJacobian(self.model, self.data, j, frame) for j in unique])
+        origins = np.array([self.data.oMi[j].translation for j in unique])
+        index = np.searchsorted(unique, joints)
+        J = stack.reshape(-1, 6, self.nq)[index]
+        lever = np.cross(points - origins.reshape(-1, 3)[index], directions)
+        return np.einsum("ki,kin->kn", directions, J[:, :3]) + np.einsum(
+            "ki,kin->kn", lever, J[:, 3:]
+        )
 
 
 def _check_size(urdf: Path, max_links: int) -> None:

@@ -16,7 +16,8 @@ from articula.geometry.shapes import ConvexShape, box, capsule, cylinder, sphere
 from articula.limits import MAX_DECOMPOSE_VERTICES, MAX_LENGTH, MAX_LINKS, MAX_SCALE, MIN_SCALE
 from articula.robots.model import RobotModel
 from articula.scene.obstacles import Obstacle
-from articula.scene.scene import Metric, Scene, link_pairs
+from articula.scene.pairs import link_pairs
+from articula.scene.scene import Metric, Scene
 from articula.scene.self_collision import (
     MARGIN,
     SAMPLES,

@@ -11,7 +11,6 @@ exact ones, which lets the broad phase skip pairs that cannot be the minimum.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Literal
 
 import coal
@@ -24,29 +23,11 @@ from articula.geometry.poses import transform_points
 from articula.geometry.shapes import ConvexShape
 from articula.robots.model import RobotModel
 from articula.scene.obstacles import Obstacle
+from articula.scene.pairs import SelfWitnesses, Witnesses, link_pairs
 
 Metric = Literal["gjk", "vertex"]
 _NO_SUPPORT_GUESS = np.zeros(2, dtype=np.int32)
 _NO_GJK_GUESS = np.array([1.0, 0.0, 0.0])
-
-
-@dataclass(frozen=True)
-class Witnesses:
-    """Signed distances (links × obstacles) [m] and the closest points [m, world] per cell."""
-
-    distance: np.ndarray
-    on_link: np.ndarray  # (links, obstacles, 3)
-    on_obstacle: np.ndarray  # (links, obstacles, 3)
-
-
-@dataclass(frozen=True)
-class SelfWitnesses:
-    """Signed distance [m] of every checked link pair (a, b) and the closest points [m, world]
-    on link a and on link b."""
-
-    distance: np.ndarray  # (pairs,)
-    on_a: np.ndarray  # (pairs, 3)
-    on_b: np.ndarray  # (pairs, 3)
 
 
 class _Geometry:
@@ -190,7 +171,19 @@ class Scene:
 
     def witnesses(self, q: Sequence[float] | np.ndarray, t: float = 0.0) -> Witnesses:
         """Distances with the closest point on the link and on the obstacle for each cell."""
-        d = self._pair_distances(self.robot.check_q(q), t, every_pair=True)
+        return self.witnesses_within(q, t)[0]
+
+    def witnesses_within(
+        self, q: Sequence[float] | np.ndarray, t: float = 0.0, within: float = np.inf
+    ) -> tuple[Witnesses, SelfWitnesses]:
+        """Witnesses of every cell and of every checked link pair, from one pass; with the
+        broad phase, a pair whose capsules are `within` [m] or farther apart is not computed,
+        so a cell or link pair farther than that may read +inf (a controller that only acts
+        below an influence distance asks for no more)."""
+        d = self._pair_distances(self.robot.check_q(q), t, every_pair=True, within=within)
+        return self._witnesses(d), self._self_witnesses(d)
+
+    def _witnesses(self, d: list[float]) -> Witnesses:
         on_link = np.full((*self._shape, 3), np.nan)
         on_obstacle = np.full((*self._shape, 3), np.nan)
         best = np.full(self._shape, np.inf)
@@ -206,7 +199,9 @@ class Scene:
 
     def self_witnesses(self, q: Sequence[float] | np.ndarray) -> SelfWitnesses:
         """Self distances with the closest point on each link of each pair."""
-        d = self._pair_distances(self.robot.check_q(q), 0.0, every_pair=True)
+        return self.witnesses_within(q)[1]
+
+    def _self_witnesses(self, d: list[float]) -> SelfWitnesses:
         n = len(self.self_pairs)
         best, on_a, on_b = np.full(n, np.inf), np.full((n, 3), np.nan), np.full((n, 3), np.nan)
         for p in range(self._n_obstacle_pairs, len(d)):
@@ -279,13 +274,21 @@ class Scene:
         pin.computeDistance(self._geo.exact, self._exact_data, p)
         return self._results[p].min_distance
 
-    def _pair_distances(self, q: np.ndarray, t: float, every_pair: bool = False) -> list[float]:
+    def _pair_distances(
+        self, q: np.ndarray, t: float, every_pair: bool = False, within: float = np.inf
+    ) -> list[float]:
         """Distance of every pair; with the broad phase, pairs that cannot be the minimum of
-        their cell are left at +inf unless `every_pair`."""
+        their cell are left at +inf unless `every_pair`, and with `every_pair` those whose
+        lower bound is `within` [m] or more."""
         n = len(self._cell_of_pair)
         if self.metric == "vertex":
             self._place(q, t)
             return [self._vertex_distance(p) for p in range(n)]
+        if every_pair and self.broadphase and within < np.inf:
+            lower = self._lower_bounds(q, t)
+            pin.updateGeometryPlacements(self.robot.model, self.robot.data, self._geo.exact,
+                                         self._exact_data)  # fmt: skip
+            return [self._exact(p) if lower[p] < within else np.inf for p in range(n)]
         if every_pair or not self.broadphase:
             self._place(q, t)
             return [self._exact(p) for p in range(n)]
@@ -378,23 +381,3 @@ class Scene:
     def _vertex_distance(self, p: int) -> float:
         on_a, on_b = self._vertex_pair(p)
         return float(np.linalg.norm(on_a - on_b))
-
-
-def link_pairs(
-    pairs: Sequence[Sequence[str]], links: list[str], field: str
-) -> tuple[tuple[int, int], ...]:
-    """Link pairs by name as sorted index pairs into `links`, each once; ConfigError naming
-    `field` for an entry that is not two different links of the list."""
-    out = set()
-    for pair in pairs:
-        if len(pair) != 2:
-            raise ConfigError(field, f"each entry needs two link names (got {list(pair)})")
-        a, b = pair
-        for name in (a, b):
-            if name not in links:
-                raise ConfigError(field, f"no link {name!r} with collision shapes; "
-                                  f"the links are {links}")  # fmt: skip
-        if a == b:
-            raise ConfigError(field, f"a link cannot collide with itself ({a!r})")
-        out.add(tuple(sorted((links.index(a), links.index(b)))))
-    return tuple(sorted(out))

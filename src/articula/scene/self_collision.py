@@ -17,7 +17,8 @@ from typing import Literal
 import numpy as np
 
 from articula.robots.model import RobotModel
-from articula.scene.scene import Scene, link_pairs
+from articula.scene.pairs import link_pairs
+from articula.scene.scene import Scene
 
 Reason = Literal["adjacent", "never close", "always touching", "allowed"]
 SAMPLES = 1000  # random configurations; MoveIt's assistant defaults to 10,000 collision checks

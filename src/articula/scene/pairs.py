@@ -1,0 +1,50 @@
+"""What a Scene's pair queries return (closest points per cell or per link pair), and the
+check of link pairs named in a scene file."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from articula.errors import ConfigError
+
+
+@dataclass(frozen=True)
+class Witnesses:
+    """Signed distances (links × obstacles) [m] and the closest points [m, world] per cell."""
+
+    distance: np.ndarray
+    on_link: np.ndarray  # (links, obstacles, 3)
+    on_obstacle: np.ndarray  # (links, obstacles, 3)
+
+
+@dataclass(frozen=True)
+class SelfWitnesses:
+    """Signed distance [m] of every checked link pair (a, b) and the closest points [m, world]
+    on link a and on link b."""
+
+    distance: np.ndarray  # (pairs,)
+    on_a: np.ndarray  # (pairs, 3)
+    on_b: np.ndarray  # (pairs, 3)
+
+
+def link_pairs(
+    pairs: Sequence[Sequence[str]], links: list[str], field: str
+) -> tuple[tuple[int, int], ...]:
+    """Link pairs by name as sorted index pairs into `links`, each once; ConfigError naming
+    `field` for an entry that is not two different links of the list."""
+    out = set()
+    for pair in pairs:
+        if len(pair) != 2:
+            raise ConfigError(field, f"each entry needs two link names (got {list(pair)})")
+        a, b = pair
+        for name in (a, b):
+            if name not in links:
+                raise ConfigError(field, f"no link {name!r} with collision shapes; "
+                                  f"the links are {links}")  # fmt: skip
+        if a == b:
+            raise ConfigError(field, f"a link cannot collide with itself ({a!r})")
+        out.add(tuple(sorted((links.index(a), links.index(b)))))
+    return tuple(sorted(out))
