@@ -1,0 +1,247 @@
+"""articula's arm controllers beside mink, in one process, same arm and obstacles (issue 13).
+
+    python benchmarks/peers.py [--json] [--steps N]      (needs pip install -e '.[peers]')
+
+Scene: book/ch1/configs/circle_two_obstacles.toml (iiwa14, the bracket and the rock as
+convex hulls, the circle of Eq. 1.27 from the home position, the scene's [planner] table).
+Three controllers run one 10 ms control period per call, with the scene's d_min = 0.002 m,
+detection distance 0.15 m (articula's influence), the URDF's joint speed limits and a
+position task on the end effector:
+  qp          articula's OnlineController, method "qp" (NEO-style dampers solved by daqp;
+              its dampers stop at articula's default safety distance, 0.03 m)
+  improved    articula's OnlineController, method "baornn-improved" (the scene's Λ, c1, c2,
+              d_min as its hard minimum distance)
+  mink        benchmarks/mink_peer.py: mink.solve_ik (daqp) with a FrameTask on the
+              end-effector site, ConfigurationLimit, VelocityLimit and
+              CollisionAvoidanceLimit (minimum distance d_min, mink's default gain 0.85)
+              between every link hull and every obstacle hull, the same hulls as articula's
+              (MuJoCo mesh geoms)
+and, for the record, mink_matched: mink with its collision gain turned into a damper like the
+qp's. mink bounds a displacement Δq by gain (d − d_min) / dt, so the default gain lets a pair
+close 85 (d − d_min) in one 10 ms period: the bound holds only once d ≤ d_min, and a link
+moving fast goes through it (here the forearm into the bracket). gain = dt² · 1 m/s /
+(detection − d_min) is the qp's damper rate [1/s] in those units.
+
+The controllers step round-robin, one period each in turn (the order rotating every period),
+so that machine noise hits all alike; every period is timed alone (perf_counter_ns around the
+call):
+  <name>_step_us              median µs per control period
+  qp_vs_mink, improved_vs_mink  ratios of those medians (> 1: articula slower)
+  <name>_rms_m, _max_error_m  RMS and largest distance [m] of the end effector from the
+                              reference after settle_s = min(5 s, half the run)
+  <name>_min_clearance_m      smallest articula Scene.min_distance [m] over the run (mink's q
+                              measured by articula's scene too)
+  <name>_far_step_us          median µs per period with 0, 1, 2, 4, 8 far obstacles
+                              (half-size rock copies 2 m from the base axis, farther than the
+                              detection distance from every link over the whole motion:
+                              far_min_distance_m), from a second round-robin race of all
+                              controllers on all those scenes, far_steps periods
+  <name>_per_far_obstacle_us  least-squares slope of those medians over the count
+mink checks its pairs one by one below 16 pairs (the two obstacles make 14) and with a
+vectorized bounding-sphere broad phase from 16 on, so its cost steps up from 0 to 1 far
+obstacle and is nearly flat after.
+"""
+
+from __future__ import annotations
+
+import statistics
+import sys
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from common import run
+
+from articula.book.study import packaged
+from articula.geometry.shapes import convex_hull
+from articula.loops.online import OnlineController
+from articula.planning.config import PlannerSpec, TrajectorySpec, make_targets
+from articula.scene.config import build_scene, load_scene_spec
+from articula.scene.obstacles import Obstacle
+from articula.scene.scene import Scene
+from articula.validation import load_toml
+
+SCENE = "circle_two_obstacles.toml"
+INFLUENCE = 0.15  # [m] articula's qp influence distance = mink's collision_detection_distance
+FAR_COUNTS = (0, 1, 2, 4, 8)
+FAR_RADIUS = 2.0  # [m] from the base axis; the iiwa14 reaches about 1.3 m
+FAR_STEPS = 300  # periods of the far-obstacle race (fewer when --steps is smaller)
+WARMUP = 5  # periods run (and discarded) by each controller before the race: JIT, caches
+NAMES = ("qp", "improved", "mink")
+INSTALL = "pip install -e '.[peers]'"
+
+
+@dataclass
+class Lane:
+    """One controller in a race: its step function, and what its periods did."""
+
+    name: str
+    step: Callable[[np.ndarray], np.ndarray]
+    times_ns: list[int] = field(default_factory=list)
+    qs: list[np.ndarray] = field(default_factory=list)
+
+
+def measure(steps: int) -> dict[str, Any]:
+    """Run the races and return the measures (see the module's docstring)."""
+    from mink_peer import MinkArm  # needs mink and mujoco: pip install -e '.[peers]'
+
+    if steps < 2:
+        print("error: --steps must be at least 2", file=sys.stderr)
+        raise SystemExit(2)
+
+    path = packaged("ch1", SCENE)
+    data = load_toml(path)
+    scene, q0 = build_scene(load_scene_spec(data), path.parent)
+    table = {**data["planner"], "limits": "velocity", "influence": INFLUENCE}
+    specs = {
+        "qp": PlannerSpec(**{**table, "method": "qp"}),
+        "improved": PlannerSpec(**{**table, "method": "baornn-improved"}),
+    }
+    d_min, dt = specs["qp"].d_min, specs["qp"].dt
+    seed = int(table.get("seed", 0))
+    targets = make_targets(TrajectorySpec(**data["trajectory"]), path.parent)
+    reference = np.array([targets(n * dt).position for n in range(max(steps, FAR_STEPS))])
+    # A damper like the qp's (1 m/s over the detection band) in mink's units: its bound is
+    # gain (d − d_min) / dt on a displacement Δq, so the rate [1/s] needs a factor dt².
+    matched_gain = dt**2 * 1.0 / (INFLUENCE - d_min)
+
+    def lanes(s: Scene, matched: bool = False) -> list[Lane]:
+        out = [Lane(name, _articula(s, specs[name], seed, q0)) for name in ("qp", "improved")]
+        out.append(Lane("mink", _mink(MinkArm(s, d_min, INFLUENCE, dt), q0)))
+        if matched:
+            arm = MinkArm(s, d_min, INFLUENCE, dt, gain=matched_gain)
+            out.append(Lane("mink_matched", _mink(arm, q0)))
+        return out
+
+    main = lanes(scene, matched=True)
+    _race(main, reference[:steps])
+    far_steps = min(steps, FAR_STEPS)
+    far_scenes = {n: with_far_obstacles(scene, n) for n in FAR_COUNTS}
+    far = {n: lanes(s) for n, s in far_scenes.items()}
+    _race([lane for n in FAR_COUNTS for lane in far[n]], reference[:far_steps])
+
+    settle = min(5.0, steps * dt / 2)
+    settled = np.arange(steps) * dt >= settle
+    m: dict[str, Any] = {"steps": steps, "far_steps": far_steps, "dt_s": dt, "d_min_m": d_min,
+                         "detection_m": INFLUENCE, "settle_s": settle,
+                         "mink_matched_gain": matched_gain,
+                         "far_counts": list(FAR_COUNTS)}  # fmt: skip
+    for lane in main:
+        q = np.array(lane.qs)
+        x = np.array([scene.robot.ee_position(qn) for qn in q])
+        error = np.linalg.norm(x - reference[:steps], axis=1)
+        m[f"{lane.name}_step_us"] = statistics.median(lane.times_ns) / 1e3
+        m[f"{lane.name}_rms_m"] = float(np.sqrt(np.mean(error[settled] ** 2)))
+        m[f"{lane.name}_max_error_m"] = float(error[settled].max())
+        m[f"{lane.name}_min_clearance_m"] = float(min(scene.min_distance(qn) for qn in q))
+    for name in ("qp", "improved"):
+        m[f"{name}_vs_mink"] = m[f"{name}_step_us"] / m["mink_step_us"]
+    counts = np.array(FAR_COUNTS, dtype=float)
+    for k, name in enumerate(NAMES):
+        medians = [statistics.median(far[n][k].times_ns) / 1e3 for n in FAR_COUNTS]
+        m[f"{name}_far_step_us"] = medians
+        m[f"{name}_per_far_obstacle_us"] = float(np.polyfit(counts, medians, 1)[0])
+    m["far_min_distance_m"] = far_clearance(far_scenes[max(FAR_COUNTS)], scene, main)
+    return m
+
+
+def _articula(scene: Scene, spec: PlannerSpec, seed: int, q0: np.ndarray):
+    """A warmed-up OnlineController's step, reset to q0."""
+    controller = OnlineController.from_spec(scene, spec, seed=seed)
+    q = controller.reset(q0)
+    for _ in range(WARMUP):
+        controller.step(scene.robot.ee_position(q))
+    controller.reset(q0)
+    return controller.step
+
+
+def _mink(arm, q0: np.ndarray):
+    """A warmed-up MinkArm's step, reset to q0."""
+    q = arm.reset(q0)
+    for _ in range(WARMUP):
+        arm.step(arm.scene.robot.ee_position(q))
+    arm.reset(q0)
+    return arm.step
+
+
+def _race(lanes: Sequence[Lane], reference: np.ndarray) -> None:
+    """Every lane tracks `reference` (one row per period), one period each in turn; the order
+    rotates every period."""
+    clock = time.perf_counter_ns
+    n = len(lanes)
+    for k, target in enumerate(reference):
+        for i in range(n):
+            lane = lanes[(i + k) % n]
+            start = clock()
+            q = lane.step(target)
+            lane.times_ns.append(clock() - start)
+            lane.qs.append(q)
+
+
+def with_far_obstacles(scene: Scene, count: int) -> Scene:
+    """`scene` with `count` half-size copies of its rock, FAR_RADIUS from the base axis at
+    z = 0.5 m, evenly spread around it."""
+    rock = next(o for o in scene.obstacles if o.name == "rock")
+    small = tuple(convex_hull(0.5 * part.vertices, "far rock") for part in rock.parts)
+    extra = []
+    for k in range(count):
+        angle = 2 * np.pi * k / max(count, 1) + 0.3
+        pose = np.eye(4)
+        pose[:3, 3] = [FAR_RADIUS * np.cos(angle), FAR_RADIUS * np.sin(angle), 0.5]
+        extra.append(Obstacle(f"far{k}", small, pose))
+    return Scene(scene.robot, (*scene.obstacles, *extra), scene.broadphase, scene.metric,
+                 scene.self_pair_names)  # fmt: skip
+
+
+def far_clearance(far_scene: Scene, scene: Scene, lanes: Sequence[Lane]) -> float:
+    """Smallest distance [m] from any link to any far obstacle over every lane's motion
+    (every fifth period)."""
+    n = len(scene.obstacles)
+    qs = [q for lane in lanes for q in lane.qs[::5]]
+    return float(min(far_scene.distances(q)[:, n:].min() for q in qs))
+
+
+def table(m: dict[str, Any]) -> tuple[str, list[str], list[list[str]]]:
+    """The measures as (title, columns, rows) for a person."""
+    rows = []
+    for name, label in (("qp", "qp"), ("improved", "baornn-improved"), ("mink", "mink"),
+                        ("mink_matched", f"mink {m['mink_matched_gain']:.1e}")):  # fmt: skip
+        ratio = f"{m[f'{name}_step_us'] / m['mink_step_us']:.2f}"
+        slope = m.get(f"{name}_per_far_obstacle_us")
+        rows.append(
+            [
+                label,
+                f"{m[f'{name}_step_us']:.0f}",
+                ratio,
+                "" if slope is None else f"{slope:+.1f}",
+                f"{1e6 * m[f'{name}_rms_m']:.3g}",
+                f"{1e3 * m[f'{name}_min_clearance_m']:.2f}",
+            ]
+        )
+    title = (
+        f"one 10 ms period, median of {m['steps']} (far obstacles {m['far_counts']}: "
+        f"{m['far_steps']} periods, ≥ {m['far_min_distance_m']:.2f} m away); RMS after "
+        f"{m['settle_s']:g} s"
+    )
+    columns = ["controller", "µs/period", "× mink", "µs/far obst.", "RMS µm", "clear. mm"]
+    return title, columns, rows
+
+
+def main() -> None:
+    """Refuse to start without mink, then run."""
+    try:
+        import mink  # noqa: F401
+        import mujoco  # noqa: F401
+    except ImportError as exc:
+        print(f"error: {exc.name} is not installed; {INSTALL}", file=sys.stderr)
+        raise SystemExit(2) from None
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    steps = {"type": int, "default": 1000, "help": "control periods of the main race"}
+    run(__doc__, measure, table, steps=steps)
+
+
+if __name__ == "__main__":
+    main()
