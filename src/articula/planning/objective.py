@@ -53,6 +53,8 @@ class Objective:
         if c is None:
             raise ModelError("this scene has no compiled evaluation (see Objective.compiled)")
         pairs, static_min = c.select(self.needs_obstacles, True)
+        if box is not None:
+            pairs = c.near_pairs(pairs, box)  # a period's reach: far obstacles drop out
         lower, upper = box or (robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
         return (self.lambda_weight, self.beta, self.d_min, lower, upper, c.arrays(pairs),
                 static_min)  # fmt: skip

@@ -12,6 +12,7 @@ obstacle clearance and the self clearance (the scene's checked link pairs) come 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -21,6 +22,13 @@ from scipy.spatial import ConvexHull
 
 from articula.geometry.shapes import ConvexShape
 from articula.numba_cache import jit
+from articula.scene.compiled_poses import (
+    _apply,
+    _capsule_gaps,
+    _compose,
+    _joint_poses,
+    _shape_poses,
+)
 from articula.scene.gjk import gjk_distance
 from articula.scene.scene import Scene
 
@@ -56,6 +64,7 @@ class CompiledClearance:
     capsule_r: np.ndarray
     pairs: np.ndarray  # (pairs, 4) (shape, shape, guess row, OBSTACLE | SELF) that can move
     static_min: np.ndarray  # (2,) smallest distance of the pairs that never move, per kind
+    reach: float  # [m] no shape point is farther than this from any joint origin, in any pose
 
     @classmethod
     def build(cls, scene: Scene) -> CompiledClearance | None:
@@ -123,6 +132,7 @@ class CompiledClearance:
             capsule_r=np.array([b[2] for b in bounds], dtype=float),
             pairs=_pair_rows(moving, index),
             static_min=np.full(2, np.inf),
+            reach=_reach(placements, poses[:n_links], cores[:n_links]),
         )
         if fixed:
             q0 = np.zeros(model.nq)
@@ -146,6 +156,21 @@ class CompiledClearance:
         keep = np.array([obstacles, self_pairs])
         return self.pairs[keep[self.pairs[:, 3]]], np.where(keep, self.static_min, np.inf)
 
+    def near_pairs(self, pairs: np.ndarray, box: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+        """The rows of `pairs` that can hold the smallest link-obstacle distance anywhere in
+        `box` (lower, upper joint angles [rad]); link pairs are all kept.
+
+        A shape point moves at most reach · Σ|Δq_j| from the box's centre c, so over the box
+        a pair stays above its lower bound at c less that δ, and the smallest distance stays
+        below the smallest upper bound at c plus δ: a pair whose lower bound exceeds that by
+        2δ can never be the minimum (nor reach GJK in `_evaluate`'s broad phase).
+        """
+        return _near_pairs(box[0], box[1], self.reach, self.static_min[OBSTACLE], self.parents,
+                           self.joint_rot, self.joint_p, self.axes, self.q_index, self.vertices,
+                           self.starts, self.radii, self.shape_joint, self.shape_rot,
+                           self.shape_p, self.capsule_a, self.capsule_b, self.capsule_r,
+                           pairs)  # fmt: skip
+
     def arrays(self, pairs: np.ndarray | None = None) -> tuple:
         """The arguments of the compiled evaluation after q (all but static_min)."""
         pairs = self.pairs if pairs is None else pairs
@@ -154,6 +179,19 @@ class CompiledClearance:
                 self.offsets, self.hints, self.guesses, self.radii,
                 self.shape_joint, self.shape_rot, self.shape_p, self.capsule_a, self.capsule_b,
                 self.capsule_r, pairs)  # fmt: skip
+
+
+def _reach(placements: list, poses: list[np.ndarray], cores: list) -> float:
+    """A bound [m] on the distance between any point of a link shape and any joint origin:
+    every joint origin lies within Σ|joint offsets| of the base, and every shape point within
+    that plus its own extent."""
+    chain = float(sum(np.linalg.norm(p.translation) for p in placements))
+    extent = max(
+        (np.linalg.norm(T[:3, 3]) + float(np.max(np.linalg.norm(core[0], axis=1))) + core[1]
+         for T, core in zip(poses, cores, strict=True)),
+        default=0.0,
+    )  # fmt: skip
+    return 2.0 * chain + extent
 
 
 def _pair_rows(pairs: list[tuple[int, int, int]], index: dict) -> np.ndarray:
@@ -201,70 +239,45 @@ def _capsule_ends(shape: ConvexShape) -> tuple[np.ndarray, np.ndarray, float]:
 
 
 @jit()
-def _compose(
-    R1: np.ndarray, p1: np.ndarray, R2: np.ndarray, p2: np.ndarray, R: np.ndarray, p: np.ndarray
-) -> None:
-    """(R, p) = (R1, p1) ∘ (R2, p2): R = R1 R2, p = p1 + R1 p2 (3×3 by hand: no BLAS call)."""
-    for i in range(3):
-        p[i] = p1[i] + R1[i, 0] * p2[0] + R1[i, 1] * p2[1] + R1[i, 2] * p2[2]
-        for k in range(3):
-            R[i, k] = R1[i, 0] * R2[0, k] + R1[i, 1] * R2[1, k] + R1[i, 2] * R2[2, k]
+def _pair_bounds(
+    q, parents, joint_rot, joint_p, axes, q_index, vertices, starts, radii, shape_joint,
+    shape_rot, shape_p, capsule_a, capsule_b, capsule_r, pairs,
+):  # fmt: skip
+    """(lower, upper) bounds of every pair's distance at q: its capsules' gap, and the gap
+    between the balls of radius r around one core point of each shape."""
+    oR, op = _joint_poses(q, parents, joint_rot, joint_p, axes, q_index)
+    world_R, world_p, ends = _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a,
+                                          capsule_b)  # fmt: skip
+    upper = np.empty(pairs.shape[0])
+    point_a = np.empty(3)
+    point_b = np.empty(3)
+    for k in range(pairs.shape[0]):
+        a, b = pairs[k, 0], pairs[k, 1]
+        _apply(world_R[a], world_p[a], vertices[starts[a]], point_a)
+        _apply(world_R[b], world_p[b], vertices[starts[b]], point_b)
+        gap = point_a - point_b
+        upper[k] = math.sqrt(gap @ gap) - radii[a] - radii[b]
+    return _capsule_gaps(ends, capsule_r, pairs), upper
 
 
 @jit()
-def _rotate_about(R: np.ndarray, axis: np.ndarray, angle: float, out: np.ndarray) -> None:
-    """out = R · Rot(axis, angle) (Rodrigues), axis a unit vector."""
-    c, s = np.cos(angle), np.sin(angle)
-    x, y, z = axis[0], axis[1], axis[2]
-    C = 1.0 - c
-    r00, r01, r02 = c + x * x * C, x * y * C - z * s, x * z * C + y * s
-    r10, r11, r12 = y * x * C + z * s, c + y * y * C, y * z * C - x * s
-    r20, r21, r22 = z * x * C - y * s, z * y * C + x * s, c + z * z * C
-    for i in range(3):
-        a, b, d = R[i, 0], R[i, 1], R[i, 2]
-        out[i, 0] = a * r00 + b * r10 + d * r20
-        out[i, 1] = a * r01 + b * r11 + d * r21
-        out[i, 2] = a * r02 + b * r12 + d * r22
-
-
-@jit()
-def _apply(R: np.ndarray, p: np.ndarray, x: np.ndarray, out: np.ndarray) -> None:
-    """out = R x + p."""
-    for i in range(3):
-        out[i] = R[i, 0] * x[0] + R[i, 1] * x[1] + R[i, 2] * x[2] + p[i]
-
-
-@jit()
-def _segment_distance(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> float:
-    """Distance between segments [p1, q1] and [p2, q2] (Ericson, Sect. 5.1.9), in scalars."""
-    d1x, d1y, d1z = q1[0] - p1[0], q1[1] - p1[1], q1[2] - p1[2]
-    d2x, d2y, d2z = q2[0] - p2[0], q2[1] - p2[1], q2[2] - p2[2]
-    rx, ry, rz = p1[0] - p2[0], p1[1] - p2[1], p1[2] - p2[2]
-    a = d1x * d1x + d1y * d1y + d1z * d1z
-    e = d2x * d2x + d2y * d2y + d2z * d2z
-    f = d2x * rx + d2y * ry + d2z * rz
-    s = 0.0
-    t = 0.0
-    if a > 1e-18 or e > 1e-18:
-        if a <= 1e-18:
-            t = min(max(f / e, 0.0), 1.0)
-        else:
-            c = d1x * rx + d1y * ry + d1z * rz
-            if e <= 1e-18:
-                s = min(max(-c / a, 0.0), 1.0)
-            else:
-                b = d1x * d2x + d1y * d2y + d1z * d2z
-                denom = a * e - b * b
-                s = min(max((b * f - c * e) / denom, 0.0), 1.0) if denom > 0.0 else 0.0
-                t = (b * s + f) / e
-                if t < 0.0:
-                    t, s = 0.0, min(max(-c / a, 0.0), 1.0)
-                elif t > 1.0:
-                    t, s = 1.0, min(max((b - c) / a, 0.0), 1.0)
-    gx = rx + d1x * s - d2x * t
-    gy = ry + d1y * s - d2y * t
-    gz = rz + d1z * s - d2z * t
-    return np.sqrt(gx * gx + gy * gy + gz * gz)
+def _near_pairs(
+    lower, upper, reach, static_min, parents, joint_rot, joint_p, axes, q_index, vertices,
+    starts, radii, shape_joint, shape_rot, shape_p, capsule_a, capsule_b, capsule_r, pairs,
+):  # fmt: skip
+    """CompiledClearance.near_pairs in one compiled call (it runs once per control period)."""
+    centre = (lower + upper) / 2.0
+    delta = reach * np.sum(upper - lower) / 2.0
+    below, above = _pair_bounds(centre, parents, joint_rot, joint_p, axes, q_index, vertices,
+                                starts, radii, shape_joint, shape_rot, shape_p, capsule_a,
+                                capsule_b, capsule_r, pairs)  # fmt: skip
+    ceiling = static_min
+    for k in range(pairs.shape[0]):
+        if pairs[k, 3] == 0 and above[k] < ceiling:
+            ceiling = above[k]
+    ceiling += 2.0 * delta
+    keep = np.array([pairs[k, 3] != 0 or below[k] <= ceiling for k in range(pairs.shape[0])])
+    return pairs[keep]
 
 
 @jit()
@@ -277,36 +290,17 @@ def _evaluate(
     forward kinematics, shape poses, capsule lower bounds, then exact GJK in order of bound,
     skipping a pair whose bound is not below the best distance of its kind (the broad phase
     of Scene)."""
-    nj = parents.size
-    oR = np.empty((nj, 3, 3))
-    op = np.empty((nj, 3))
-    oR[0] = np.eye(3)
-    op[0] = 0.0
-    placed = np.empty((3, 3))
-    for j in range(1, nj):
-        parent = parents[j]
-        _compose(oR[parent], op[parent], joint_rot[j], joint_p[j], placed, op[j])
-        _rotate_about(placed, axes[j], q[q_index[j]], oR[j])
+    oR, op = _joint_poses(q, parents, joint_rot, joint_p, axes, q_index)
     ee = np.empty(3)
     _apply(oR[ee_joint], op[ee_joint], ee_p, ee)
     ee_R = np.empty((3, 3))
     _compose(oR[ee_joint], op[ee_joint], ee_rot, ee_p, ee_R, np.empty(3))
-    ns = radii.size
-    world_R = np.empty((ns, 3, 3))
-    world_p = np.empty((ns, 3))
-    ends = np.empty((ns, 2, 3))
-    for s in range(ns):
-        j = shape_joint[s]
-        _compose(oR[j], op[j], shape_rot[s], shape_p[s], world_R[s], world_p[s])
-        _apply(world_R[s], world_p[s], capsule_a[s], ends[s, 0])
-        _apply(world_R[s], world_p[s], capsule_b[s], ends[s, 1])
+    world_R, world_p, ends = _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a,
+                                          capsule_b)  # fmt: skip
     npairs = pairs.shape[0]
-    lower = np.empty(npairs)
+    lower = _capsule_gaps(ends, capsule_r, pairs)
     has_obstacle = has_self = False  # a kind without pairs here cannot improve
     for k in range(npairs):
-        a, b = pairs[k, 0], pairs[k, 1]
-        gap = _segment_distance(ends[a, 0], ends[a, 1], ends[b, 0], ends[b, 1])
-        lower[k] = gap - capsule_r[a] - capsule_r[b]
         if pairs[k, 3] == 1:
             has_self = True
         else:

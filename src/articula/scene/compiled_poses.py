@@ -1,0 +1,117 @@
+"""Compiled kinematics of the clearance path: joint and shape poses of a revolute chain, and
+the capsule broad phase's segment distances (numba, scalar arithmetic: no BLAS calls)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from articula.numba_cache import jit
+
+
+@jit()
+def _compose(
+    R1: np.ndarray, p1: np.ndarray, R2: np.ndarray, p2: np.ndarray, R: np.ndarray, p: np.ndarray
+) -> None:
+    """(R, p) = (R1, p1) ∘ (R2, p2): R = R1 R2, p = p1 + R1 p2 (3×3 by hand: no BLAS call)."""
+    for i in range(3):
+        p[i] = p1[i] + R1[i, 0] * p2[0] + R1[i, 1] * p2[1] + R1[i, 2] * p2[2]
+        for k in range(3):
+            R[i, k] = R1[i, 0] * R2[0, k] + R1[i, 1] * R2[1, k] + R1[i, 2] * R2[2, k]
+
+
+@jit()
+def _rotate_about(R: np.ndarray, axis: np.ndarray, angle: float, out: np.ndarray) -> None:
+    """out = R · Rot(axis, angle) (Rodrigues), axis a unit vector."""
+    c, s = np.cos(angle), np.sin(angle)
+    x, y, z = axis[0], axis[1], axis[2]
+    C = 1.0 - c
+    r00, r01, r02 = c + x * x * C, x * y * C - z * s, x * z * C + y * s
+    r10, r11, r12 = y * x * C + z * s, c + y * y * C, y * z * C - x * s
+    r20, r21, r22 = z * x * C - y * s, z * y * C + x * s, c + z * z * C
+    for i in range(3):
+        a, b, d = R[i, 0], R[i, 1], R[i, 2]
+        out[i, 0] = a * r00 + b * r10 + d * r20
+        out[i, 1] = a * r01 + b * r11 + d * r21
+        out[i, 2] = a * r02 + b * r12 + d * r22
+
+
+@jit()
+def _apply(R: np.ndarray, p: np.ndarray, x: np.ndarray, out: np.ndarray) -> None:
+    """out = R x + p."""
+    for i in range(3):
+        out[i] = R[i, 0] * x[0] + R[i, 1] * x[1] + R[i, 2] * x[2] + p[i]
+
+
+@jit()
+def _segment_distance(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.ndarray) -> float:
+    """Distance between segments [p1, q1] and [p2, q2] (Ericson, Sect. 5.1.9), in scalars."""
+    d1x, d1y, d1z = q1[0] - p1[0], q1[1] - p1[1], q1[2] - p1[2]
+    d2x, d2y, d2z = q2[0] - p2[0], q2[1] - p2[1], q2[2] - p2[2]
+    rx, ry, rz = p1[0] - p2[0], p1[1] - p2[1], p1[2] - p2[2]
+    a = d1x * d1x + d1y * d1y + d1z * d1z
+    e = d2x * d2x + d2y * d2y + d2z * d2z
+    f = d2x * rx + d2y * ry + d2z * rz
+    s = 0.0
+    t = 0.0
+    if a > 1e-18 or e > 1e-18:
+        if a <= 1e-18:
+            t = min(max(f / e, 0.0), 1.0)
+        else:
+            c = d1x * rx + d1y * ry + d1z * rz
+            if e <= 1e-18:
+                s = min(max(-c / a, 0.0), 1.0)
+            else:
+                b = d1x * d2x + d1y * d2y + d1z * d2z
+                denom = a * e - b * b
+                s = min(max((b * f - c * e) / denom, 0.0), 1.0) if denom > 0.0 else 0.0
+                t = (b * s + f) / e
+                if t < 0.0:
+                    t, s = 0.0, min(max(-c / a, 0.0), 1.0)
+                elif t > 1.0:
+                    t, s = 1.0, min(max((b - c) / a, 0.0), 1.0)
+    gx = rx + d1x * s - d2x * t
+    gy = ry + d1y * s - d2y * t
+    gz = rz + d1z * s - d2z * t
+    return np.sqrt(gx * gx + gy * gy + gz * gz)
+
+
+@jit()
+def _joint_poses(q, parents, joint_rot, joint_p, axes, q_index):  # fmt: skip
+    """World rotation and origin of every joint frame at q (joint 0: the world)."""
+    nj = parents.size
+    oR = np.empty((nj, 3, 3))
+    op = np.empty((nj, 3))
+    oR[0] = np.eye(3)
+    op[0] = 0.0
+    placed = np.empty((3, 3))
+    for j in range(1, nj):
+        parent = parents[j]
+        _compose(oR[parent], op[parent], joint_rot[j], joint_p[j], placed, op[j])
+        _rotate_about(placed, axes[j], q[q_index[j]], oR[j])
+    return oR, op
+
+
+@jit()
+def _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a, capsule_b):  # fmt: skip
+    """World pose of every shape and the ends of its bounding capsule's segment."""
+    ns = shape_joint.size
+    world_R = np.empty((ns, 3, 3))
+    world_p = np.empty((ns, 3))
+    ends = np.empty((ns, 2, 3))
+    for s in range(ns):
+        j = shape_joint[s]
+        _compose(oR[j], op[j], shape_rot[s], shape_p[s], world_R[s], world_p[s])
+        _apply(world_R[s], world_p[s], capsule_a[s], ends[s, 0])
+        _apply(world_R[s], world_p[s], capsule_b[s], ends[s, 1])
+    return world_R, world_p, ends
+
+
+@jit()
+def _capsule_gaps(ends, capsule_r, pairs):  # fmt: skip
+    """Capsule-capsule distance of every pair: a lower bound of its exact distance."""
+    lower = np.empty(pairs.shape[0])
+    for k in range(pairs.shape[0]):
+        a, b = pairs[k, 0], pairs[k, 1]
+        gap = _segment_distance(ends[a, 0], ends[a, 1], ends[b, 0], ends[b, 1])
+        lower[k] = gap - capsule_r[a] - capsule_r[b]
+    return lower
