@@ -91,8 +91,10 @@ def test_tracking_metrics_by_hand():
     assert m["min_clearance"] == -0.01 and m["min_clearance_settled"] == 0.05
     assert m["collisions"] == 1 and m["collisions_settled"] == 0
     assert m["joint_limit_violations"] == 1
-    assert m["time_per_iteration_us"] == pytest.approx(50.0)
-    assert m["time_per_period_us"] == pytest.approx(500.0)
+    # 2 ms over the 3 periods after the first, 10 iterations each.
+    assert m["time_per_iteration_us"] == pytest.approx(2000.0 / 30)
+    assert m["time_per_period_us"] == pytest.approx(2000.0 / 3)
+    assert m["first_period_ms"] == 0.0
 
 
 def test_trace_columns_name_each_series():

@@ -11,10 +11,12 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from articula.errors import ConfigError
+from articula.planning.clearance import RowSource
 from articula.planning.config import TrajectorySpec, make_targets
 from articula.planning.reference_velocity import rotation_vector, task_rows
 from articula.planning.task import Target, Task
 from articula.robots import RobotModel
+from articula.scene import Scene
 from articula.validation import parse_model
 from tests.robots.helpers import central_differences
 
@@ -49,9 +51,15 @@ def rotation_at(q: np.ndarray) -> np.ndarray:
     return ROBOT.ee_pose(q)[:3, :3]
 
 
+def rows_at(task: Task, target: Target) -> tuple[np.ndarray, np.ndarray]:
+    """task_rows at Q, the end effector from the compiled kinematics (RowSource)."""
+    ee, _ = RowSource(Scene(ROBOT, []))(Q, 0.0, 0.15)
+    return task_rows(ee.x, ee.R, ee.J, task, target, None, 0.01, 1.0)
+
+
 def test_pose_rows_are_the_jacobian_of_position_and_rotation():
     target = Target(np.zeros(3), np.eye(3))
-    J, _ = task_rows(ROBOT, Q, Task("pose"), target, None, 0.01, 1.0)
+    J, _ = rows_at(Task("pose"), target)
     fd_x = central_differences(lambda q: ROBOT.ee_position(q), Q, 1e-6)
     # Rotation rows: ω with R(q + δq) ≈ exp(ω̂ δt) R(q), world axes.
     R0 = rotation_at(Q)
@@ -63,7 +71,7 @@ def test_pose_rows_are_the_jacobian_of_position_and_rotation():
 def test_axis_rows_move_the_tool_axis_as_finite_differences_do():
     tool = np.array([0.0, 0.0, 1.0])
     task = Task("position+axis", tool_axis=tool)
-    J, _ = task_rows(ROBOT, Q, task, Target(np.zeros(3), axis=tool), None, 0.01, 1.0)
+    J, _ = rows_at(task, Target(np.zeros(3), axis=tool))
     assert J.shape == (5, ROBOT.nq)
     a = rotation_at(Q) @ tool
     fd_a = central_differences(lambda q: rotation_at(q) @ tool, Q, 1e-6)  # ȧ per joint

@@ -51,7 +51,7 @@ class ImprovedBaornn(BeetleSearch):
         obj, p = self.objective, self.params
         draw = self.rng.standard_normal((q.size, min(p.pairs, q.size)))
         if obj.compiled is not None:
-            return self._compiled(q, g, target, draw[None])
+            return self._compiled(q, g, np.zeros(0), target, draw[None])
         lam = p.c1 * math.sqrt(obj.tracking_error(q, target))
         # Orthonormal directions: QR of a Gaussian matrix (columns), as many as pairs.
         directions, _ = np.linalg.qr(draw)
@@ -90,37 +90,38 @@ class ImprovedBaornn(BeetleSearch):
         target = as_target(target)
         start = q
         self._begin_period(q)
-        g = self.objective.value(q, target, t)
-        if self._last_motion is not None:
-            warm = q + self._last_motion
-            q_warm, g_warm = self.objective.project_and_value(warm, q, g, target, t, self._box)
-            self.evaluations += 1
-            if g_warm < g:
-                q, g = q_warm, g_warm
         p = self.params
         if self.objective.compiled is not None:
             # The same draws as iterations_per_step calls of iterate, in one compiled call.
             draws = self.rng.standard_normal((p.iterations_per_step, q.size, min(p.pairs, q.size)))
-            q, g = self._compiled(q, g, target, draws)
+            warm = np.zeros(0) if self._last_motion is None else self._last_motion
+            q, _ = self._compiled(q, math.nan, warm, target, draws)
         else:
+            g = self.objective.value(q, target, t)
+            if self._last_motion is not None:
+                q_warm, g_warm = self.objective.project_and_value(
+                    q + self._last_motion, q, g, target, t, self._box
+                )
+                self.evaluations += 1
+                if g_warm < g:
+                    q, g = q_warm, g_warm
             for _ in range(p.iterations_per_step):
                 q, g = self.iterate(q, g, target, t)
         self._last_motion = q - start
         return self._end_period(start, q)
 
     def _compiled(
-        self, q: np.ndarray, g: float, target: Target, draws: np.ndarray
+        self, q: np.ndarray, g: float, warm: np.ndarray, target: Target, draws: np.ndarray
     ) -> tuple[np.ndarray, float]:
-        """The iterations of `draws` by planning/baornn_kernel.py."""
+        """From q with g = g(q) (NaN: computed there), a warm start (none when `warm` is empty)
+        and the iterations of `draws` by planning/baornn_kernel.py."""
         obj, p = self.objective, self.params
         lambda_weight, beta, d_min, lower, upper, arrays, static_min = obj.kernel_arguments(
             self._box
         )
-        q, g, evaluations = kernel.improved_iterations(
-            q, g, target.position, obj.orient_arguments(target), draws, p.c1, p.c2,
-            p.short_antenna,
-            lambda_weight, beta, d_min, lower, upper, arrays, obj.kinematics_arguments(),
-            static_min,
+        q, g, evaluations = kernel.improved_period(
+            q, g, warm, target.position, obj.orient_arguments(target), draws, p.c1, p.c2,
+            p.short_antenna, lambda_weight, beta, d_min, lower, upper, arrays, static_min,
         )  # fmt: skip
         self.evaluations += evaluations
         self.iterations += draws.shape[0]

@@ -29,21 +29,27 @@ def _task_error(ee, ee_R, x_ref, orient):  # fmt: skip
 
 @jit()
 def _project_and_value(
-    q, q_current, g_current, x_ref, orient, lambda_weight, beta, d_min, lower, upper, arrays,
-    static_min,
+    q, q_current, g_current, e_current, x_ref, orient, lambda_weight, beta, d_min, lower, upper,
+    arrays, static_min,
 ):  # fmt: skip
-    """(P_Ω(q), g there), Eqs. (1.17)-(1.18); stays at (q_current, g_current) unless the
-    clipped point keeps d > d_min (1.12) and clear of itself: clearance is 0 on overlap, so
-    d_min = 0 still rejects a point inside an obstacle. The pairs in `arrays` are the ones
-    that count (an obstacle clearance of +inf: none)."""
+    """(P_Ω(q), g there, the task error e there), Eqs. (1.17)-(1.18); stays at (q_current,
+    g_current, e_current) unless the clipped point keeps d > d_min (1.12) and clear of itself:
+    clearance is 0 on overlap, so d_min = 0 still rejects a point inside an obstacle. The
+    pairs in `arrays` are the ones that count (an obstacle clearance of +inf: none)."""
     clipped = np.minimum(np.maximum(q, lower), upper)
     d, d_self, ee, ee_R = _evaluate(clipped, *arrays, static_min)
     if d <= d_min or d_self <= 0.0:
-        return q_current, g_current
-    g = _task_error(ee, ee_R, x_ref, orient)  # Eq. (1.5), with the orientation term
+        return q_current, g_current, e_current
+    e = _task_error(ee, ee_R, x_ref, orient)  # Eq. (1.5), with the orientation term
+    return clipped, _penalised(e, d, lambda_weight, beta), e
+
+
+@jit()
+def _penalised(e, d, lambda_weight, beta):  # fmt: skip
+    """g = e + Λ/d^β (Eq. 1.7), e alone without a penalty or an obstacle to count."""
     if lambda_weight > 0.0 and d < np.inf:
-        g += lambda_weight / d**beta if d > 0.0 else np.inf  # Eq. (1.7)
-    return clipped, g
+        return e + lambda_weight / d**beta if d > 0.0 else np.inf
+    return e
 
 
 @jit()
@@ -56,18 +62,18 @@ def iterations(
     for k in range(directions.shape[0]):
         b = directions[k] / math.sqrt(directions[k] @ directions[k])
         lam = c1 * math.sqrt(g) if math.isfinite(g) else c1  # Eq. (1.23)
-        _, g_left = _project_and_value(q + lam * b, q, g, x_ref, orient, lambda_weight, beta,
-                                            d_min, lower, upper, arrays,
-                                            static_min)  # fmt: skip
-        _, g_right = _project_and_value(q - lam * b, q, g, x_ref, orient, lambda_weight, beta,
-                                              d_min, lower, upper, arrays,
-                                              static_min)  # fmt: skip
+        _, g_left, _ = _project_and_value(q + lam * b, q, g, 0.0, x_ref, orient, lambda_weight,
+                                          beta, d_min, lower, upper, arrays,
+                                          static_min)  # fmt: skip
+        _, g_right, _ = _project_and_value(q - lam * b, q, g, 0.0, x_ref, orient, lambda_weight,
+                                           beta, d_min, lower, upper, arrays,
+                                           static_min)  # fmt: skip
         diff = g_left - g_right
         sign = 1.0 if diff > 0.0 else (-1.0 if diff < 0.0 else 0.0)  # 0 when both are inf
         step = q - c2 * lam * sign * b  # Eqs. (1.19), (1.24)
-        q_new, g_new = _project_and_value(step, q, g, x_ref, orient, lambda_weight, beta, d_min,
-                                          lower, upper, arrays,
-                                          static_min)  # fmt: skip
+        q_new, g_new, _ = _project_and_value(step, q, g, 0.0, x_ref, orient, lambda_weight,
+                                             beta, d_min, lower, upper, arrays,
+                                             static_min)  # fmt: skip
         if g_new < g:  # Eqs. (1.21)-(1.22)
             q, g = q_new, g_new
     return q, g
@@ -80,45 +86,56 @@ def antenna_scale(pair: int, short: float) -> float:
 
 
 @jit()
-def improved_iterations(
-    q, g, x_ref, orient, draws, c1, c2, short, lambda_weight, beta, d_min, lower, upper,
-    arrays, kinematics, static_min,
+def improved_period(
+    q, g_known, warm_motion, x_ref, orient, draws, c1, c2, short, lambda_weight, beta, d_min, lower,
+    upper, arrays, static_min,
 ):  # fmt: skip
-    """baornn-improved's iterations (planning/baornn_improved.py), one per draws[k], an
+    """One control period of baornn-improved (planning/baornn_improved.py): g at q for the
+    new reference (g_known instead when it is not NaN: a caller's g(q)), the warm start
+    q + warm_motion (none when it is empty), then one iteration per draws[k], an
     (n × pairs) Gaussian matrix whose QR gives the antenna directions; returns the accepted
     (q, g) and the number of objective evaluations."""
-    n = q.size
+    d, _, ee, ee_R = _evaluate(q, *arrays, static_min)
+    e = _task_error(ee, ee_R, x_ref, orient)
+    g = _penalised(e, d, lambda_weight, beta) if math.isnan(g_known) else g_known
     evaluations = 0
+    if warm_motion.size:
+        q_warm, g_warm, e_warm = _project_and_value(q + warm_motion, q, g, e, x_ref, orient,
+                                                    lambda_weight, beta, d_min, lower, upper,
+                                                    arrays, static_min)  # fmt: skip
+        evaluations += 1
+        if g_warm < g:
+            q, g, e = q_warm, g_warm, e_warm
+    n = q.size
     for k in range(draws.shape[0]):
-        _, _, ee, ee_R = _evaluate(q, *kinematics, static_min)
-        lam = c1 * math.sqrt(_task_error(ee, ee_R, x_ref, orient))  # c1·√e_k
+        lam = c1 * math.sqrt(e)  # c1·√e_k, e_k the task error at the accepted q
         directions, _ = np.linalg.qr(draws[k])
         gradient = np.zeros(n)
-        best_q, best_g = q, g
+        best_q, best_g, best_e = q, g, e
         for j in range(directions.shape[1]):
             b = np.ascontiguousarray(directions[:, j])
             scale = antenna_scale(j, short)
-            q_left, g_left = _project_and_value(q + scale * lam * b, q, g, x_ref, orient,
-                                                lambda_weight, beta, d_min, lower, upper,
-                                                arrays, static_min)  # fmt: skip
-            q_right, g_right = _project_and_value(q - scale * lam * b, q, g, x_ref, orient,
-                                                  lambda_weight, beta, d_min, lower, upper,
-                                                  arrays, static_min)  # fmt: skip
+            q_left, g_left, e_left = _project_and_value(
+                q + scale * lam * b, q, g, e, x_ref, orient, lambda_weight, beta, d_min, lower,
+                upper, arrays, static_min)  # fmt: skip
+            q_right, g_right, e_right = _project_and_value(
+                q - scale * lam * b, q, g, e, x_ref, orient, lambda_weight, beta, d_min, lower,
+                upper, arrays, static_min)  # fmt: skip
             evaluations += 2
             if math.isfinite(g_left) and math.isfinite(g_right):
                 gradient += (g_left - g_right) / scale * b
             if g_left < best_g:
-                best_q, best_g = q_left, g_left
+                best_q, best_g, best_e = q_left, g_left, e_left
             if g_right < best_g:
-                best_q, best_g = q_right, g_right
+                best_q, best_g, best_e = q_right, g_right, e_right
         norm = math.sqrt(gradient @ gradient)
         if norm > 0.0:
             step = q - c2 * lam * gradient / norm  # Eq. (1.19) along the estimated gradient
-            q_new, g_new = _project_and_value(step, q, g, x_ref, orient, lambda_weight, beta, d_min,
-                                              lower, upper, arrays,
-                                              static_min)  # fmt: skip
+            q_new, g_new, e_new = _project_and_value(step, q, g, e, x_ref, orient, lambda_weight,
+                                                     beta, d_min, lower, upper, arrays,
+                                                     static_min)  # fmt: skip
             evaluations += 1
             if g_new < best_g:  # Eqs. (1.21)-(1.22)
-                best_q, best_g = q_new, g_new
-        q, g = best_q, best_g
+                best_q, best_g, best_e = q_new, g_new, e_new
+        q, g, e = best_q, best_g, best_e
     return q, g, evaluations

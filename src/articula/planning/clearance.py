@@ -1,4 +1,5 @@
-"""Link-obstacle and link-link distances near the robot with their gradients in joint space."""
+"""Link-obstacle and link-link distances near the robot with their gradients in joint space,
+and the end effector's kinematics the resolved-rate controllers take with them."""
 
 from __future__ import annotations
 
@@ -7,6 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from articula.scene import compiled_rows
+from articula.scene.compiled_clearance import CompiledClearance
 from articula.scene.scene import Scene
 
 
@@ -18,6 +21,47 @@ class ClearanceRows:
     distance: np.ndarray
     gradient: np.ndarray
     self_pair: np.ndarray
+
+
+@dataclass(frozen=True)
+class EndEffector:
+    """The end effector at q: position x [m], rotation R (3×3, world) and Jacobian J (6 × nq,
+    world axes, linear rows first)."""
+
+    x: np.ndarray
+    R: np.ndarray
+    J: np.ndarray
+
+
+class RowSource:
+    """End-effector kinematics and clearance rows of a scene at q, in one compiled call where
+    the scene allows it (CompiledClearance; for a period where a pair overlaps, or a scene it
+    does not cover, through Pinocchio and coal: the same quantities, to GJK's tolerance)."""
+
+    def __init__(self, scene: Scene, use_compiled: bool = True) -> None:
+        self.scene = scene
+        self.compiled = CompiledClearance.build(scene) if use_compiled else None
+
+    def __call__(
+        self, q: np.ndarray, t: float, influence: float
+    ) -> tuple[EndEffector, ClearanceRows]:
+        """(the end effector, the rows closer than `influence` [m]) at q [rad], time t [s]."""
+        if self.compiled is not None:
+            out = compiled_rows.clearance_rows(self.compiled, q, influence)
+            if out is not None:
+                x, R, J, distance, gradient, self_pair = out
+                return EndEffector(x, R, J), ClearanceRows(distance, gradient, self_pair)
+        robot = self.scene.robot
+        J = robot.jacobian(q)
+        robot.forward(q)
+        placement = robot.data.oMf[robot.ee_frame_id]
+        end = EndEffector(placement.translation.copy(), placement.rotation.copy(), J)
+        if not self.scene.has_clearance:
+            return end, ClearanceRows(np.zeros(0), np.zeros((0, q.size)), np.zeros(0, bool))
+        rows = clearance_rows(self.scene, q, t, influence)
+        moving = np.any(rows.gradient != 0.0, axis=1)  # as the compiled rows: none fixed
+        return end, ClearanceRows(rows.distance[moving], rows.gradient[moving],
+                                  rows.self_pair[moving])  # fmt: skip
 
 
 def clearance_rows(scene: Scene, q: np.ndarray, t: float, influence: float) -> ClearanceRows:

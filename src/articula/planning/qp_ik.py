@@ -5,12 +5,14 @@ every period."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import daqp
 import numpy as np
 from pydantic import model_validator
 
-from articula.planning.clearance import clearance_rows
+from articula.numba_cache import jit
+from articula.planning.clearance import RowSource
 from articula.planning.reference_velocity import RateParams, task_rows
 from articula.planning.task import Target, Task, as_target
 from articula.scene.scene import Scene
@@ -51,16 +53,21 @@ class QpIkParams(RateParams):
 
 @dataclass
 class QpIk:
-    """The NEO-style controller on the same Scene distances and Jacobians (daqp via qpsolvers)."""
+    """The NEO-style controller on the same Scene distances and Jacobians, solved by daqp."""
 
     scene: Scene
     dt: float
     params: QpIkParams = field(default_factory=QpIkParams)
     d_min: float = 0.0
     task: Task = field(default_factory=Task)
+    use_compiled: bool = True
     iterations: int = field(default=0, init=False)
     infeasible: int = field(default=0, init=False)
     _previous: Target | None = field(default=None, init=False)
+    _rows: RowSource = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self._rows = RowSource(self.scene, self.use_compiled)
 
     def reset(self) -> None:
         """Forget the previous target: the next period has no feed-forward."""
@@ -75,49 +82,66 @@ class QpIk:
             return q.copy()
         return self.scene.robot.clip(q + self.dt * qdot)
 
-    def _solve(self, q: np.ndarray, target: Target | np.ndarray, t: float) -> np.ndarray | None:
+    def _solve(self, q: np.ndarray, target: Target, t: float) -> np.ndarray | None:
         robot, p, n = self.scene.robot, self.params, self.scene.robot.nq
-        J, v = task_rows(robot, q, self.task, target, self._previous, self.dt, p.gain)
+        ee, rows = self._rows(q, t, p.influence)
+        J, v = task_rows(ee.x, ee.R, ee.J, self.task, target, self._previous, self.dt, p.gain)
         self._previous = target
-        m = J.shape[0]  # task rows, each with its slack
-        dampers, h = self._clearance_dampers(q, t)
-        # Joint-limit dampers: the same law on the room left to each limit [rad].
-        up = robot.model.upperPositionLimit - q
-        down = q - robot.model.lowerPositionLimit
-        near_up = np.flatnonzero(up < p.limit_influence)
-        near_down = np.flatnonzero(down < p.limit_influence)
-        span = p.limit_influence - p.limit_safety
-        rooms = np.r_[up[near_up], down[near_down]]
-        k = len(dampers) + rooms.size  # inequality rows
-        # daqp's layout: box bounds on (q̇, δ), then G x ≤ h, then J q̇ + δ = v (sense 5).
-        rows = np.zeros((k + m, n + m))
-        rows[: len(dampers), :n] = dampers
-        limit_rows = rows[len(dampers) : k]
-        limit_rows[np.arange(near_up.size), near_up] = 1.0
-        limit_rows[near_up.size + np.arange(near_down.size), near_down] = -1.0
-        rows[k:, :n] = J
-        rows[k:, n:] = np.eye(m)
-        limit = p.speed_scale * np.where(robot.velocity_limit > 0, robot.velocity_limit, 1e3)
-        bound = np.r_[limit, np.full(m, 1e3)]
-        upper = np.r_[bound, h, p.damper_gain * (rooms - p.limit_safety) / span, v]
-        lower = np.full(upper.size, -1e30)
-        lower[: n + m] = -bound
-        sense = np.zeros(upper.size, dtype=np.intc)
-        sense[n + m + k :] = 5  # equality rows
-        weights = np.r_[np.full(n, p.joint_weight), np.full(m, p.slack_weight)]
-        solution, _, status, _ = daqp.solve(np.diag(weights), np.zeros(n + m), rows, upper,
-                                            lower, sense)  # fmt: skip
+        model = robot.model
+        H, A, upper, lower, sense = _qp_arrays(
+            q, model.lowerPositionLimit, model.upperPositionLimit, self._speed_bound, J, v,
+            rows.distance, rows.gradient, rows.self_pair, p.safety, p.self_safety, p.influence,
+            p.damper_gain, p.limit_influence, p.limit_safety, p.joint_weight, p.slack_weight,
+        )  # fmt: skip
+        solution, _, status, _ = daqp.solve(H, np.zeros(H.shape[0]), A, upper, lower, sense)
         return solution[:n] if status > 0 else None
 
-    def _clearance_dampers(self, q: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray]:
-        """(−∇d rows, their bounds) of the velocity dampers on every distance within the
-        influence distance: −∇d·q̇ ≤ ξ (d − d_s)/(d_i − d_s), approach no faster than that."""
-        p, n = self.params, self.scene.robot.nq
-        if not self.scene.has_clearance:
-            return np.zeros((0, n)), np.zeros(0)
-        rows = clearance_rows(self.scene, q, t, p.influence)
-        # A world-fixed link: no joint changes its d, so no row can help.
-        moving = np.any(rows.gradient != 0.0, axis=1)
-        safety = np.where(rows.self_pair[moving], p.self_safety, p.safety)
-        h = p.damper_gain * (rows.distance[moving] - safety) / (p.influence - safety)
-        return -rows.gradient[moving], h
+    @cached_property
+    def _speed_bound(self) -> np.ndarray:
+        """The joint speed bound [rad/s]: a URDF limit of 0 means none was given."""
+        limit = self.scene.robot.velocity_limit
+        return self.params.speed_scale * np.where(limit > 0, limit, 1e3)
+
+
+@jit()
+def _qp_arrays(
+    q, q_lower, q_upper, speed_bound, J, v, distance, gradient, self_pair, safety, self_safety,
+    influence, damper_gain, limit_influence, limit_safety, joint_weight, slack_weight,
+):  # fmt: skip
+    """daqp's (H, A, upper, lower, sense) of one period: box bounds on (q̇, δ), then the
+    inequality rows G x ≤ h, then the task rows J q̇ + δ = v (sense 5, equality)."""
+    n, m, c = q.size, J.shape[0], distance.size
+    near_up = np.flatnonzero(q_upper - q < limit_influence)
+    near_down = np.flatnonzero(q - q_lower < limit_influence)
+    k = c + near_up.size + near_down.size  # inequality rows
+    A = np.zeros((k + m, n + m))
+    upper = np.empty(n + m + k + m)
+    lower = np.full(upper.size, -1e30)
+    upper[:n] = speed_bound
+    upper[n : n + m] = 1e3
+    # Velocity dampers: −∇d·q̇ ≤ ξ (d − d_s)/(d_i − d_s), approach no faster than that.
+    for r in range(c):
+        d_s = self_safety if self_pair[r] else safety
+        A[r, :n] = -gradient[r]
+        upper[n + m + r] = damper_gain * (distance[r] - d_s) / (influence - d_s)
+    # Joint-limit dampers: the same law on the room left to each limit [rad].
+    span = limit_influence - limit_safety
+    for i, j in enumerate(near_up):
+        A[c + i, j] = 1.0
+        upper[n + m + c + i] = damper_gain * (q_upper[j] - q[j] - limit_safety) / span
+    for i, j in enumerate(near_down):
+        A[c + near_up.size + i, j] = -1.0
+        upper[n + m + c + near_up.size + i] = (
+            damper_gain * (q[j] - q_lower[j] - limit_safety) / span
+        )
+    A[k:, :n] = J
+    for i in range(m):
+        A[k + i, n + i] = 1.0
+    upper[n + m + k :] = v
+    lower[: n + m] = -upper[: n + m]
+    sense = np.zeros(upper.size, dtype=np.intc)
+    sense[n + m + k :] = 5
+    H = np.zeros((n + m, n + m))
+    for i in range(n + m):
+        H[i, i] = joint_weight if i < n else slack_weight
+    return H, A, upper, lower, sense

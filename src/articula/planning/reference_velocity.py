@@ -9,7 +9,6 @@ import numpy as np
 import pinocchio as pin
 
 from articula.planning.task import Target, Task, target_arrays
-from articula.robots.model import RobotModel
 from articula.validation import NonNegative, Positive, StrictModel
 
 
@@ -43,25 +42,23 @@ def reference_velocity(
 
 
 def task_rows(
-    robot: RobotModel,
-    q: np.ndarray,
+    x: np.ndarray,
+    R: np.ndarray,
+    J: np.ndarray,
     task: Task,
     target: Target,
     previous: Target | None,
     dt: float,
     gain: float,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """(J_task, v): the task Jacobian rows (rows × nq) and the velocity they should have.
+    """(J_task, v): the task Jacobian rows (rows × nq) and the velocity they should have, for
+    the end effector at position x [m], rotation R with Jacobian J (6 × nq, world axes).
 
     Position: J_v (3 rows) and ẋ_r + K e (reference_velocity). Pose: also J_ω (3 rows) and
     ω = log(R_r R_r,prevᵀ)/dt + K log(R_r,prev Rᵀ), the same feed-forward and feedback on the
     rotation (world axes). Position+axis: the two rows of J_ω across the tool axis a, and
     there the rotation that takes a to the reference axis (its feed-forward likewise).
     """
-    J = robot.jacobian(q)
-    robot.forward(q)
-    placement = robot.data.oMf[robot.ee_frame_id]
-    x, R = placement.translation, placement.rotation
     v = reference_velocity(
         target.position, None if previous is None else previous.position, x, dt, gain
     )

@@ -8,7 +8,7 @@ from typing import Literal
 
 import numpy as np
 
-from articula.planning.clearance import clearance_rows
+from articula.planning.clearance import ClearanceRows, RowSource
 from articula.planning.reference_velocity import RateParams, task_rows
 from articula.planning.task import Target, Task, as_target
 from articula.scene.scene import Scene
@@ -41,8 +41,13 @@ class VelocityIk:
     params: VelocityIkParams = field(default_factory=VelocityIkParams)
     d_min: float = 0.0
     task: Task = field(default_factory=Task)
+    use_compiled: bool = True
     iterations: int = field(default=0, init=False)
     _previous: Target | None = field(default=None, init=False)
+    _rows: RowSource = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self._rows = RowSource(self.scene, self.use_compiled)
 
     def reset(self) -> None:
         """Forget the previous target: the next period has no feed-forward."""
@@ -52,7 +57,8 @@ class VelocityIk:
         """One period: integrate q̇ for dt and clip to the joint limits."""
         robot, p = self.scene.robot, self.params
         target = as_target(target)
-        J, v = task_rows(robot, q, self.task, target, self._previous, self.dt, p.gain)
+        ee, rows = self._rows(q, t, p.influence)
+        J, v = task_rows(ee.x, ee.R, ee.J, self.task, target, self._previous, self.dt, p.gain)
         self._previous = target
         m = J.shape[0]
         # Singular values below 1e-6 of the largest are round-off (the stretched home pose has
@@ -65,16 +71,16 @@ class VelocityIk:
         limit = p.speed_scale * robot.velocity_limit
         # The repulsion grows like 1/d³: capped at half the joint speeds on its own, so that it
         # cannot, through the uniform scaling below, stall the task it is projected around.
-        repulsion = _limit_speed(self._repulsion(q, t), 0.5 * limit)
+        repulsion = _limit_speed(self._repulsion(rows), 0.5 * limit)
         qdot = J_task @ v + (np.eye(robot.nq) - J_pinv @ J) @ repulsion
         self.iterations += 1
         return robot.clip(q + self.dt * _limit_speed(qdot, limit))
 
-    def _repulsion(self, q: np.ndarray, t: float) -> np.ndarray:
+    def _repulsion(self, rows: ClearanceRows) -> np.ndarray:
+        """The null-space term q̇_0 [rad/s] of the rows within the influence distance."""
         p = self.params
-        if not self.scene.has_clearance or p.repulsion == 0:
-            return np.zeros(q.size)
-        rows = clearance_rows(self.scene, q, t, p.influence)
+        if rows.distance.size == 0 or p.repulsion == 0:
+            return np.zeros(self.scene.robot.nq)
         d = np.maximum(rows.distance, 1e-3)  # inside an obstacle: push as hard as at 1 mm
         weights = p.repulsion * (1.0 / d - 1.0 / p.influence) / d**2
         return weights @ rows.gradient

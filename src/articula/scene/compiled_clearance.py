@@ -27,6 +27,8 @@ from articula.scene.compiled_poses import (
     _capsule_gaps,
     _compose,
     _joint_poses,
+    _remember,
+    _remembered_bound,
     _shape_poses,
 )
 from articula.scene.gjk import gjk_distance
@@ -55,6 +57,9 @@ class CompiledClearance:
     offsets: np.ndarray  # (total + 1,)
     hints: np.ndarray  # (shapes,) where each support search starts (mutable scratch)
     guesses: np.ndarray  # (pairs, 3) last closest point of each pair's A − B (mutable scratch)
+    memory: np.ndarray  # (pairs, 25) last exact distance, then the two shapes' poses (R, p)
+    # at that time (mutable scratch; distance −inf: none yet)
+    extents: np.ndarray  # (shapes,) largest |x| of a core vertex in the shape's frame [m]
     radii: np.ndarray  # (shapes,)
     shape_joint: np.ndarray  # (shapes,) joint a shape moves with (0: the world)
     shape_rot: np.ndarray  # (shapes, 3, 3) shape pose in its joint frame (world for obstacles)
@@ -62,7 +67,8 @@ class CompiledClearance:
     capsule_a: np.ndarray  # (shapes, 3) ends of each bounding capsule, in the shape's frame
     capsule_b: np.ndarray
     capsule_r: np.ndarray
-    pairs: np.ndarray  # (pairs, 4) (shape, shape, guess row, OBSTACLE | SELF) that can move
+    pairs: np.ndarray  # (pairs, 5) (shape, shape, guess row, OBSTACLE | SELF, cell) that move
+    cells: int  # (link, obstacle) cells, row-major, then the checked link pairs in scene order
     static_min: np.ndarray  # (2,) smallest distance of the pairs that never move, per kind
     reach: float  # [m] no shape point is farther than this from any joint origin, in any pose
 
@@ -75,7 +81,7 @@ class CompiledClearance:
             return None
         if any(name not in _AXES and name != "JointModelRevoluteUnaligned" for name in names):
             return None
-        shapes, joints, poses, owner = [], [], [], []
+        shapes, joints, poses, owner, part_of = [], [], [], [], []
         # Without anything to keep clear of only the kinematics are needed: no shape at all.
         for li, link in enumerate(scene.robot.links if scene.has_clearance else ()):
             frame = model.frames[link.frame_id]
@@ -85,11 +91,12 @@ class CompiledClearance:
                 poses.append((frame.placement * pin.SE3(T)).homogeneous)
                 owner.append(li)
         n_links = len(shapes)
-        for obstacle in scene.obstacles:
+        for oi, obstacle in enumerate(scene.obstacles):
             for part in obstacle.parts:
                 shapes.append(part)
                 joints.append(0)
                 poses.append(obstacle.pose_at(0.0))
+                part_of.append(oi)
         cores = [_core(s) for s in shapes]
         if any(c is None for c in cores):
             return None
@@ -101,10 +108,14 @@ class CompiledClearance:
             name = joint.shortname()
             axes[j] = _AXES[name] if name in _AXES else joint.extract().axis
         bounds = [_capsule_ends(s) for s in shapes]
-        pairs = [(a, b, OBSTACLE) for a in range(n_links) for b in range(n_links, len(shapes))]
-        pairs += [(a, b, SELF) for la, lb in scene.self_pairs for a in range(n_links)
+        n_obstacles = len(scene.obstacles)
+        cell_count = len(scene.robot.links) * n_obstacles + len(scene.self_pairs)
+        pairs = [(a, b, OBSTACLE, owner[a] * n_obstacles + part_of[b - n_links])
+                 for a in range(n_links) for b in range(n_links, len(shapes))]  # fmt: skip
+        pairs += [(a, b, SELF, cell_count - len(scene.self_pairs) + k)
+                  for k, (la, lb) in enumerate(scene.self_pairs) for a in range(n_links)
                   for b in range(n_links) if (owner[a], owner[b]) == (la, lb)]  # fmt: skip
-        moving = [(a, b, kind) for a, b, kind in pairs if joints[a] != 0 or joints[b] != 0]
+        moving = [pair for pair in pairs if joints[pair[0]] != 0 or joints[pair[1]] != 0]
         index = {pair: k for k, pair in enumerate(pairs)}
         fixed = [pair for pair in pairs if pair not in moving]
         placements = model.jointPlacements
@@ -123,6 +134,8 @@ class CompiledClearance:
             offsets=offsets,
             hints=starts[:-1].copy(),
             guesses=np.zeros((len(pairs), 3)),
+            memory=np.full((len(pairs), 25), -np.inf),
+            extents=np.array([np.max(np.linalg.norm(c[0], axis=1)) for c in cores]),
             radii=np.array([c[1] for c in cores], dtype=float),
             shape_joint=np.array(joints, dtype=np.int64),
             shape_rot=np.array([T[:3, :3] for T in poses]).reshape(-1, 3, 3),
@@ -131,6 +144,7 @@ class CompiledClearance:
             capsule_b=np.array([b[1] for b in bounds]).reshape(-1, 3),
             capsule_r=np.array([b[2] for b in bounds], dtype=float),
             pairs=_pair_rows(moving, index),
+            cells=cell_count,
             static_min=np.full(2, np.inf),
             reach=_reach(placements, poses[:n_links], cores[:n_links]),
         )
@@ -140,7 +154,7 @@ class CompiledClearance:
             object.__setattr__(out, "static_min", np.array(static[:2]))
         return out
 
-    no_pairs: ClassVar[np.ndarray] = np.zeros((0, 4), dtype=np.int64)  # kinematics only
+    no_pairs: ClassVar[np.ndarray] = np.zeros((0, 5), dtype=np.int64)  # kinematics only
 
     def evaluate(
         self, q: np.ndarray, obstacles: bool = True, self_pairs: bool = True
@@ -176,7 +190,7 @@ class CompiledClearance:
         pairs = self.pairs if pairs is None else pairs
         return (self.parents, self.joint_rot, self.joint_p, self.axes, self.q_index,
                 self.ee_joint, self.ee_p, self.ee_rot, self.vertices, self.starts, self.neighbours,
-                self.offsets, self.hints, self.guesses, self.radii,
+                self.offsets, self.hints, self.guesses, self.memory, self.extents, self.radii,
                 self.shape_joint, self.shape_rot, self.shape_p, self.capsule_a, self.capsule_b,
                 self.capsule_r, pairs)  # fmt: skip
 
@@ -194,10 +208,10 @@ def _reach(placements: list, poses: list[np.ndarray], cores: list) -> float:
     return 2.0 * chain + extent
 
 
-def _pair_rows(pairs: list[tuple[int, int, int]], index: dict) -> np.ndarray:
-    """(shape a, shape b, guess row, kind) rows of `pairs`."""
-    rows = [(a, b, index[a, b, kind], kind) for a, b, kind in pairs]
-    return np.array(rows, dtype=np.int64).reshape(-1, 4)
+def _pair_rows(pairs: list[tuple[int, int, int, int]], index: dict) -> np.ndarray:
+    """(shape a, shape b, guess row, kind, cell) rows of `pairs`."""
+    rows = [(a, b, index[a, b, kind, cell], kind, cell) for a, b, kind, cell in pairs]
+    return np.array(rows, dtype=np.int64).reshape(-1, 5)
 
 
 def _core(shape: ConvexShape) -> tuple[np.ndarray, float] | None:
@@ -283,13 +297,16 @@ def _near_pairs(
 @jit()
 def _evaluate(
     q, parents, joint_rot, joint_p, axes, q_index, ee_joint, ee_p, ee_rot, vertices, starts,
-    neighbours, offsets, hints, guesses, radii, shape_joint, shape_rot, shape_p, capsule_a,
-    capsule_b, capsule_r, pairs, static_min,
+    neighbours, offsets, hints, guesses, memory, extents, radii, shape_joint, shape_rot,
+    shape_p, capsule_a, capsule_b, capsule_r, pairs, static_min,
 ):  # fmt: skip
     """(obstacle clearance, self clearance, end-effector position, end-effector rotation):
-    forward kinematics, shape poses, capsule lower bounds, then exact GJK in order of bound,
-    skipping a pair whose bound is not below the best distance of its kind (the broad phase
-    of Scene)."""
+    forward kinematics, shape poses, lower bounds, then exact GJK in order of bound, skipping
+    a pair whose bound is not below the best distance of its kind (the broad phase of Scene).
+
+    A pair's bound is the larger of its capsules' gap and its last exact distance less how far
+    each shape has moved since (`memory`; a search evaluates nearby configurations, so this
+    is the tighter one: a far pair is measured once, not at every evaluation)."""
     oR, op = _joint_poses(q, parents, joint_rot, joint_p, axes, q_index)
     ee = np.empty(3)
     _apply(oR[ee_joint], op[ee_joint], ee_p, ee)
@@ -299,6 +316,9 @@ def _evaluate(
                                           capsule_b)  # fmt: skip
     npairs = pairs.shape[0]
     lower = _capsule_gaps(ends, capsule_r, pairs)
+    for k in range(npairs):
+        lower[k] = max(lower[k], _remembered_bound(memory[pairs[k, 2]], pairs[k, 0], pairs[k, 1],
+                                                   world_R, world_p, extents))  # fmt: skip
     has_obstacle = has_self = False  # a kind without pairs here cannot improve
     for k in range(npairs):
         if pairs[k, 3] == 1:
@@ -322,6 +342,7 @@ def _evaluate(
         d = gjk_distance(vertices, neighbours, offsets, hints,
                          a, world_R[a], world_p[a], radii[a],
                          b, world_R[b], world_p[b], radii[b], guesses[pairs[k, 2]])  # fmt: skip
+        _remember(memory[pairs[k, 2]], d, world_R[a], world_p[a], world_R[b], world_p[b])
         if self_pair and d < best_self:
             best_self = d
         elif not self_pair and d < best_obstacle:

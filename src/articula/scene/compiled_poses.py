@@ -3,6 +3,8 @@ the capsule broad phase's segment distances (numba, scalar arithmetic: no BLAS c
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from articula.numba_cache import jit
@@ -115,3 +117,37 @@ def _capsule_gaps(ends, capsule_r, pairs):  # fmt: skip
         gap = _segment_distance(ends[a, 0], ends[a, 1], ends[b, 0], ends[b, 1])
         lower[k] = gap - capsule_r[a] - capsule_r[b]
     return lower
+
+
+@jit()
+def _moved(R0: np.ndarray, p0: np.ndarray, R: np.ndarray, p: np.ndarray, extent: float) -> float:
+    """A bound [m] on how far any point within `extent` of a shape's origin moved from pose
+    (R0, p0) to (R, p): |p − p0| + ||R − R0||₂ extent, ||R − R0||₂ = √(3 − tr(R0ᵀ R))."""
+    trace = 0.0
+    for i in range(3):
+        for k in range(3):
+            trace += R0[i, k] * R[i, k]
+    dx, dy, dz = p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]
+    return math.sqrt(dx * dx + dy * dy + dz * dz) + math.sqrt(max(3.0 - trace, 0.0)) * extent
+
+
+@jit()
+def _remembered_bound(memory, a, b, world_R, world_p, extents):  # fmt: skip
+    """A pair's last exact distance less how far its shapes a and b moved since: a lower
+    bound of its distance now (−inf before its first exact distance)."""
+    if memory[0] == -np.inf:
+        return -np.inf
+    R_a, p_a = memory[1:10].reshape(3, 3), memory[10:13]
+    R_b, p_b = memory[13:22].reshape(3, 3), memory[22:25]
+    return (memory[0] - _moved(R_a, p_a, world_R[a], world_p[a], extents[a])
+            - _moved(R_b, p_b, world_R[b], world_p[b], extents[b]))  # fmt: skip
+
+
+@jit()
+def _remember(memory, d, R_a, p_a, R_b, p_b):  # fmt: skip
+    """Store a pair's exact distance d [m] and the poses of its shapes it was measured at."""
+    memory[0] = d
+    memory[1:10] = R_a.ravel()
+    memory[10:13] = p_a
+    memory[13:22] = R_b.ravel()
+    memory[22:25] = p_b

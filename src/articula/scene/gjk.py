@@ -128,13 +128,15 @@ def _closest_on_triangle(
 
 
 @jit()
-def _reduce(W: np.ndarray, n: int, keep: np.ndarray) -> int:
-    """Keep only the flagged simplex vertices, packed at the front; returns their count."""
+def _reduce(W: np.ndarray, Wa: np.ndarray, n: int, keep: np.ndarray) -> int:
+    """Keep only the flagged simplex vertices (and their A supports), packed at the front;
+    returns their count."""
     m = 0
     for i in range(n):
         if keep[i]:
             for k in range(3):
                 W[m, k] = W[i, k]
+                Wa[m, k] = Wa[i, k]
             m += 1
     return m
 
@@ -155,11 +157,12 @@ def _beyond_face(W: np.ndarray, ia: int, ib: int, ic: int, iopp: int) -> bool:
 
 @jit()
 def _closest_on_simplex(
-    W: np.ndarray, n: int, keep: np.ndarray, best_keep: np.ndarray, trial: np.ndarray,
-    out: np.ndarray,
+    W: np.ndarray, Wa: np.ndarray, n: int, keep: np.ndarray, best_keep: np.ndarray,
+    trial: np.ndarray, out: np.ndarray,
 ) -> int:  # fmt: skip
-    """out = the closest point to the origin on the simplex W[:n]; returns the reduced simplex
-    size, 4 meaning the origin is inside the tetrahedron (the shapes overlap)."""
+    """out = the closest point to the origin on the simplex W[:n] (Wa: the A supports of its
+    vertices, reduced alike); returns the reduced simplex size, 4 meaning the origin is inside
+    the tetrahedron (the shapes overlap)."""
     if n == 1:
         _point_on(W, 0, 0, 0.0, out)
         return 1
@@ -173,13 +176,14 @@ def _closest_on_simplex(
         if t >= 1.0:
             for k in range(3):
                 W[0, k] = W[1, k]
+                Wa[0, k] = Wa[1, k]
             _point_on(W, 0, 0, 0.0, out)
             return 1
         _point_on(W, 0, 1, t, out)
         return 2
     if n == 3:
         _closest_on_triangle(W, 0, 1, 2, keep, out)
-        return _reduce(W, 3, keep)
+        return _reduce(W, Wa, 3, keep)
     best = np.inf
     any_outside = False
     for f in range(4):  # faces (0,1,2|3), (0,2,3|1), (0,3,1|2), (1,3,2|0)
@@ -202,7 +206,7 @@ def _closest_on_simplex(
     if not any_outside:
         return 4
     keep[:] = best_keep
-    return _reduce(W, 4, keep)
+    return _reduce(W, Wa, 4, keep)
 
 
 @jit()
@@ -220,13 +224,87 @@ def gjk_distance(
     point of A − B for this pair (zero: none), the first search direction, updated on return:
     close queries then converge in one or two iterations.
     """
-    W = np.empty((4, 3))
-    keep = np.zeros(4, dtype=np.bool_)
-    best_keep = np.zeros(4, dtype=np.bool_)
-    trial = np.empty(3)
-    w = np.empty(3)
-    v = np.empty(3)
-    v_new = np.empty(3)
+    return _gjk(vertices, neighbours, offsets, hints, a, R_a, p_a, radius_a, b, R_b, p_b,
+                radius_b, guess)[0]  # fmt: skip
+
+
+@jit()
+def gjk_witnesses(
+    vertices: np.ndarray, neighbours: np.ndarray, offsets: np.ndarray, hints: np.ndarray,
+    a: int, R_a: np.ndarray, p_a: np.ndarray, radius_a: float,
+    b: int, R_b: np.ndarray, p_b: np.ndarray, radius_b: float, guess: np.ndarray,
+    on_a: np.ndarray, on_b: np.ndarray,
+) -> float:  # fmt: skip
+    """gjk_distance, and the closest points of the two shapes' surfaces [m, world] written to
+    on_a and on_b; when the shapes overlap (0 returned) on_a and on_b are left as they were.
+
+    The points come from the final simplex: the closest point of A − B is Σ λ_i w_i with
+    w_i = a_i − b_i, so Σ λ_i a_i is a closest point of core A and that minus the closest
+    point of A − B one of core B; each moves by its radius along the normal to the surface.
+    """
+    d, W, Wa, n = _gjk(vertices, neighbours, offsets, hints, a, R_a, p_a, radius_a, b, R_b,
+                       p_b, radius_b, guess)  # fmt: skip
+    if n == 0:
+        return d
+    weights = _barycentric(W, n)
+    for k in range(3):
+        v_k = 0.0
+        a_k = 0.0
+        for i in range(n):
+            v_k += weights[i] * W[i, k]
+            a_k += weights[i] * Wa[i, k]
+        on_a[k] = a_k
+        on_b[k] = a_k - v_k
+    gap = math.sqrt(_dot(on_a - on_b, on_a - on_b))
+    if gap > 0.0:
+        for k in range(3):
+            normal = (on_a[k] - on_b[k]) / gap
+            on_a[k] -= radius_a * normal
+            on_b[k] += radius_b * normal
+    return d
+
+
+@jit()
+def _barycentric(W: np.ndarray, n: int) -> np.ndarray:
+    """Weights λ (Σ λ = 1) of the point of the affine hull of W[:n] (n ≤ 3) closest to the
+    origin; GJK's reduced simplex holds it in its relative interior."""
+    weights = np.zeros(n)
+    if n == 1:
+        weights[0] = 1.0
+        return weights
+    e1 = W[1] - W[0]
+    if n == 2:
+        denom = _dot(e1, e1)
+        t = -_dot(W[0], e1) / denom if denom > 0.0 else 0.0
+        weights[0], weights[1] = 1.0 - t, t
+        return weights
+    e2 = W[2] - W[0]  # solve the 2×2 normal equations of min |W0 + s e1 + t e2|
+    a11, a12, a22 = _dot(e1, e1), _dot(e1, e2), _dot(e2, e2)
+    b1, b2 = -_dot(W[0], e1), -_dot(W[0], e2)
+    det = a11 * a22 - a12 * a12
+    if det <= 1e-300:
+        weights[0] = 1.0
+        return weights
+    s = (b1 * a22 - b2 * a12) / det
+    t = (a11 * b2 - a12 * b1) / det
+    weights[0], weights[1], weights[2] = 1.0 - s - t, s, t
+    return weights
+
+
+@jit()
+def _gjk(
+    vertices: np.ndarray, neighbours: np.ndarray, offsets: np.ndarray, hints: np.ndarray,
+    a: int, R_a: np.ndarray, p_a: np.ndarray, radius_a: float,
+    b: int, R_b: np.ndarray, p_b: np.ndarray, radius_b: float, guess: np.ndarray,
+) -> tuple[float, np.ndarray, np.ndarray, int]:  # fmt: skip
+    """GJK itself: (distance, the final simplex W of A − B, the A supports Wa of its vertices,
+    its size n; 0 when the shapes overlap)."""
+    # Two allocations, the rest views: this runs a few hundred times per control period.
+    scratch = np.empty((13, 3))
+    W, Wa = scratch[0:4], scratch[4:8]
+    trial, w, support_a, v, v_new = scratch[8], scratch[9], scratch[10], scratch[11], scratch[12]
+    flags = np.zeros(8, dtype=np.bool_)
+    keep, best_keep = flags[0:4], flags[4:8]
     hint_a, hint_b = hints[a], hints[b]
     lower = 0.0
     # Start from a point of the Minkowski difference: the support against the last answer,
@@ -239,15 +317,18 @@ def gjk_distance(
     n = 0
     for iteration in range(_MAX_ITERATIONS + 1):
         # w = s_A(d) − s_B(−d), the support of A − B along d (first d, then −v).
-        w[0] = 0.0
-        w[1] = 0.0
-        w[2] = 0.0
-        hint_a = _support(vertices, neighbours, offsets, hint_a, R_a, p_a, dx, dy, dz, w, 1.0)
+        support_a[0] = 0.0
+        support_a[1] = 0.0
+        support_a[2] = 0.0
+        hint_a = _support(vertices, neighbours, offsets, hint_a, R_a, p_a, dx, dy, dz,
+                          support_a, 1.0)  # fmt: skip
+        w[:] = support_a
         hint_b = _support(vertices, neighbours, offsets, hint_b, R_b, p_b, -dx, -dy, -dz, w,
                           -1.0)  # fmt: skip
         if iteration == 0:
             v[:] = w
             W[0] = w
+            Wa[0] = support_a
             n = 1
         else:
             vv = _dot(v, v)
@@ -259,14 +340,15 @@ def gjk_distance(
             if vv - vw <= _RELATIVE_TOLERANCE * vv:
                 break
             W[n] = w
+            Wa[n] = support_a
             n += 1
-            n = _closest_on_simplex(W, n, keep, best_keep, trial, v_new)
+            n = _closest_on_simplex(W, Wa, n, keep, best_keep, trial, v_new)
             vv_new = _dot(v_new, v_new)
             if n == 4 or vv_new <= 1e-24:
                 hints[a] = hint_a
                 hints[b] = hint_b
                 guess[:] = 0.0
-                return 0.0
+                return 0.0, W, Wa, 0
             if vv_new >= vv:
                 break  # no more progress: the rounding floor is reached
             v[:] = v_new
@@ -275,4 +357,4 @@ def gjk_distance(
     hints[b] = hint_b
     guess[:] = v
     # The lower bound, not |v| (an upper bound): stopping early must not over-state clearance.
-    return max(lower - radius_a - radius_b, 0.0)
+    return max(lower - radius_a - radius_b, 0.0), W, Wa, n
