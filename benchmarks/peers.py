@@ -11,7 +11,7 @@ position task on the end effector:
               its dampers stop at articula's default safety distance, 0.03 m)
   improved    articula's OnlineController, method "baornn-improved" (the scene's Λ, c1, c2,
               d_min as its hard minimum distance)
-  mink        benchmarks/mink_peer.py: mink.solve_ik (daqp) with a FrameTask on the
+  mink        articula/bench/mink_peer.py: mink.solve_ik (daqp) with a FrameTask on the
               end-effector site, ConfigurationLimit, VelocityLimit and
               CollisionAvoidanceLimit (minimum distance d_min, mink's default gain 0.85)
               between every link hull and every obstacle hull, the same hulls as articula's
@@ -86,7 +86,7 @@ class Lane:
 
 def measure(steps: int) -> dict[str, Any]:
     """Run the races and return the measures (see the module's docstring)."""
-    from mink_peer import MinkArm  # needs mink and mujoco: pip install -e '.[peers]'
+    from articula.bench.mink_peer import MinkArm, matched_gain  # pip install -e '.[peers]'
 
     if steps < 2:
         print("error: --steps must be at least 2", file=sys.stderr)
@@ -104,15 +104,14 @@ def measure(steps: int) -> dict[str, Any]:
     seed = int(table.get("seed", 0))
     targets = make_targets(TrajectorySpec(**data["trajectory"]), path.parent)
     reference = np.array([targets(n * dt).position for n in range(max(steps, FAR_STEPS))])
-    # A damper like the qp's (1 m/s over the detection band) in mink's units: its bound is
-    # gain (d − d_min) / dt on a displacement Δq, so the rate [1/s] needs a factor dt².
-    matched_gain = dt**2 * 1.0 / (INFLUENCE - d_min)
+    # A damper like the qp's (1 m/s over the detection band) in mink's units.
+    gain = matched_gain(dt, d_min, INFLUENCE)
 
     def lanes(s: Scene, matched: bool = False) -> list[Lane]:
         out = [Lane(name, _articula(s, specs[name], seed, q0)) for name in ("qp", "improved")]
         out.append(Lane("mink", _mink(MinkArm(s, d_min, INFLUENCE, dt), q0)))
         if matched:
-            arm = MinkArm(s, d_min, INFLUENCE, dt, gain=matched_gain)
+            arm = MinkArm(s, d_min, INFLUENCE, dt, gain=gain)
             out.append(Lane("mink_matched", _mink(arm, q0)))
         return out
 
@@ -127,7 +126,7 @@ def measure(steps: int) -> dict[str, Any]:
     settled = np.arange(steps) * dt >= settle
     m: dict[str, Any] = {"steps": steps, "far_steps": far_steps, "dt_s": dt, "d_min_m": d_min,
                          "detection_m": INFLUENCE, "settle_s": settle,
-                         "mink_matched_gain": matched_gain,
+                         "mink_matched_gain": gain,
                          "far_counts": list(FAR_COUNTS)}  # fmt: skip
     for lane in main:
         q = np.array(lane.qs)

@@ -29,6 +29,7 @@ LAYERS = {
     "loops": 8,
     "runs": 9,
     "book": 10,
+    "bench": 10,
     "cli": 11,
     "__main__": 12,
 }

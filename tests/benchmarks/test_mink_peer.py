@@ -1,9 +1,9 @@
-"""benchmarks/mink_peer.py: mink's MuJoCo model is articula's arm and obstacles, and
+"""bench/mink_peer.py: mink's MuJoCo model is articula's arm and obstacles, and
 benchmarks/peers.py runs (skipped without the `peers` extra)."""
 
 from __future__ import annotations
 
-import importlib.util
+import importlib
 import json
 import subprocess
 import sys
@@ -23,10 +23,7 @@ pytest.importorskip("mujoco", reason=INSTALL)
 pytest.importorskip("mink", reason=INSTALL)
 
 BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
-_spec = importlib.util.spec_from_file_location("mink_peer", BENCHMARKS / "mink_peer.py")
-assert _spec is not None and _spec.loader is not None
-peer = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(peer)
+peer = importlib.import_module("articula.bench.mink_peer")
 
 D_MIN, DETECTION, DT = 0.002, 0.15, 0.01
 CIRCLE = Circle.create([0.0, 0.6, 0.5], [1, 0, 0], [0, 0, 1], 0.2, 50.0)

@@ -29,15 +29,19 @@ class QpIkParams(RateParams):
         self_safety: d_s for two links of the arm [m] (checked self-collision pairs): smaller,
             as some sit closer than `safety` by design.
         limit_influence, limit_safety: the same damper on the distance to each joint limit [rad].
+
+    The slack weight and the joint-limit damper were made stiffer and narrower in issue 13
+    (docs/deviations.md): the earlier 100 and 0.2 / 0.02 rad gave up millimetres of tracking
+    near a joint limit that mink's plain limit keeps.
     """
 
     joint_weight: NonNegative = 0.01
-    slack_weight: NonNegative = 100.0
+    slack_weight: NonNegative = 1e4
     damper_gain: NonNegative = 1.0
     safety: NonNegative = 0.03
     self_safety: NonNegative = 0.005
-    limit_influence: NonNegative = 0.2
-    limit_safety: NonNegative = 0.02
+    limit_influence: NonNegative = 0.05
+    limit_safety: NonNegative = 0.005
 
     @model_validator(mode="after")
     def _safety_inside_influence(self) -> QpIkParams:

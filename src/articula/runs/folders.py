@@ -22,12 +22,14 @@ from typing import Literal
 
 from articula.errors import ConfigError, ResourceError
 
-Kind = Literal["run", "sweep", "report"]
+Kind = Literal["run", "sweep", "report", "suite"]
 CONFIG = "config.toml"
 RECORD = "record.json"
 TRACE = "trace.parquet"
 RESULTS = "results.parquet"
 REPORT = "report.md"
+SUMMARY = "summary.json"
+SUITE_FILES = frozenset({RESULTS, SUMMARY})  # and the problems/ folder
 RUN_FILES = frozenset({CONFIG, RECORD, TRACE})
 RUN_FOLDER = re.compile(r"^[0-9a-f]{12}$")  # a sweep's run folder: the config's hash
 # What atomic_write leaves when killed mid-write: .<name>.<8 random characters>.tmp
@@ -53,6 +55,10 @@ def foreign_entries(folder: Path, kind: Kind) -> list[str]:
                 RUN_FOLDER.match(entry) is not None
                 and path.is_dir()
                 and not foreign_entries(path, "run")
+            )
+        elif kind == "suite":
+            ours = (name in SUITE_FILES and not path.is_dir()) or (
+                entry == "problems" and path.is_dir()
             )
         else:  # a report: report.md and one folder per chapter
             ours = (name == REPORT and not path.is_dir()) or (
@@ -111,7 +117,7 @@ def claimed(folder: Path, kind: Kind, force: bool = False) -> Iterator[Path]:
 def remove_stale_temporaries(folder: Path, kind: Kind) -> None:
     """Remove atomic_write's temporary files of articula's own files in `folder` (and in its
     run folders, for a sweep). Only the lock holder may call this."""
-    own = {"run": RUN_FILES, "sweep": {RESULTS}, "report": {REPORT}}[kind]
+    own = {"run": RUN_FILES, "sweep": {RESULTS}, "report": {REPORT}, "suite": SUITE_FILES}[kind]
     for entry in os.listdir(folder):
         if temporary_name_of(entry) in own:
             (folder / entry).unlink(missing_ok=True)

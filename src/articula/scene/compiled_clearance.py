@@ -261,7 +261,7 @@ def _pair_bounds(
     between the balls of radius r around one core point of each shape."""
     oR, op = _joint_poses(q, parents, joint_rot, joint_p, axes, q_index)
     world_R, world_p, ends = _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a,
-                                          capsule_b)  # fmt: skip
+                                          capsule_b, pairs)  # fmt: skip
     upper = np.empty(pairs.shape[0])
     point_a = np.empty(3)
     point_b = np.empty(3)
@@ -313,7 +313,7 @@ def _evaluate(
     ee_R = np.empty((3, 3))
     _compose(oR[ee_joint], op[ee_joint], ee_rot, ee_p, ee_R, np.empty(3))
     world_R, world_p, ends = _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a,
-                                          capsule_b)  # fmt: skip
+                                          capsule_b, pairs)  # fmt: skip
     npairs = pairs.shape[0]
     lower = _capsule_gaps(ends, capsule_r, pairs)
     for k in range(npairs):

@@ -94,17 +94,22 @@ def _joint_poses(q, parents, joint_rot, joint_p, axes, q_index):  # fmt: skip
 
 
 @jit()
-def _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a, capsule_b):  # fmt: skip
-    """World pose of every shape and the ends of its bounding capsule's segment."""
+def _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a, capsule_b, pairs):  # fmt: skip
+    """World pose of every shape of `pairs` and the ends of its bounding capsule's segment
+    (the other shapes' rows are left unset: a far obstacle costs nothing here)."""
     ns = shape_joint.size
     world_R = np.empty((ns, 3, 3))
     world_p = np.empty((ns, 3))
     ends = np.empty((ns, 2, 3))
-    for s in range(ns):
-        j = shape_joint[s]
-        _compose(oR[j], op[j], shape_rot[s], shape_p[s], world_R[s], world_p[s])
-        _apply(world_R[s], world_p[s], capsule_a[s], ends[s, 0])
-        _apply(world_R[s], world_p[s], capsule_b[s], ends[s, 1])
+    done = np.zeros(ns, dtype=np.bool_)
+    for k in range(pairs.shape[0]):
+        for s in (pairs[k, 0], pairs[k, 1]):
+            if not done[s]:
+                done[s] = True
+                j = shape_joint[s]
+                _compose(oR[j], op[j], shape_rot[s], shape_p[s], world_R[s], world_p[s])
+                _apply(world_R[s], world_p[s], capsule_a[s], ends[s, 0])
+                _apply(world_R[s], world_p[s], capsule_b[s], ends[s, 1])
     return world_R, world_p, ends
 
 

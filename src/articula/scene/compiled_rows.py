@@ -97,7 +97,7 @@ def _rows(
     _compose(oR[ee_joint], op[ee_joint], ee_rot, ee_p, ee_R, np.empty(3))
     J = _jacobian(oR, op, axes, parents, q_index, ee_joint, ee, nq)
     world_R, world_p, ends = _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a,
-                                          capsule_b)  # fmt: skip
+                                          capsule_b, pairs)  # fmt: skip
     lower = _capsule_gaps(ends, capsule_r, pairs)
     best = np.full(cells, np.inf)
     on_a = np.zeros((cells, 3))

@@ -145,6 +145,13 @@ def _add_shape(spec, body, name: str, shape, placement: pin.SE3) -> None:
                       **_pose(placement))  # fmt: skip
 
 
+def matched_gain(dt: float, d_min: float, detection: float, rate: float = 1.0) -> float:
+    """CollisionAvoidanceLimit's gain that makes its bound the qp's velocity damper: mink
+    bounds a displacement by gain (d − d_min) / dt, the damper a speed by rate (d − d_min) /
+    (detection − d_min) with rate [m/s], so gain = dt² · rate / (detection − d_min)."""
+    return dt**2 * rate / (detection - d_min)
+
+
 class MinkArm:
     """mink's differential IK on the arm of an articula Scene, one control period per step.
 
@@ -158,7 +165,7 @@ class MinkArm:
         gain: CollisionAvoidanceLimit's gain (mink's default). mink bounds the approach of a
             pair in one period, a displacement, by gain (d − d_min) / dt: the default 0.85
             binds only once d ≤ d_min at dt = 0.01 s; gain = rate [1/s] · dt² makes it a
-            damper of that rate (benchmarks/peers.py, mink_matched).
+            damper of that rate (matched_gain).
     """
 
     def __init__(

@@ -1,0 +1,136 @@
+"""`articula bench suite`: articula's arm controllers beside mink on generated problems."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from articula.cli.app import (
+    CORES,
+    Dask,
+    Force,
+    JsonFlag,
+    OutDir,
+    Workers,
+    app,
+    emit_json,
+    out,
+    progress_bar,
+)
+
+bench_app = typer.Typer(no_args_is_help=True, help="Benchmarks of articula beside its peers.")
+app.add_typer(bench_app, name="bench")
+
+
+@bench_app.command()
+def suite(
+    out_dir: OutDir,
+    robot: Annotated[
+        str,
+        typer.Option(
+            help="iiwa14, a URDF file, or a TOML file with a [robot] table "
+            "(urdf, package_dirs, ee_frame, locked_joints, ...)."
+        ),
+    ] = "iiwa14",
+    problems: Annotated[int, typer.Option(min=1, max=10_000, help="Generated problems.")] = 100,
+    seed: Annotated[int, typer.Option(min=0, help="Seed of the problems.")] = 0,
+    methods: Annotated[
+        str | None,
+        typer.Option(
+            help="Comma-separated methods (default: every articula method, and mink "
+            "and mink-matched when the peers extra is installed)."
+        ),
+    ] = None,
+    workers: Workers = CORES,
+    dask: Dask = None,
+    force: Force = False,
+    as_json: JsonFlag = False,
+) -> None:
+    """Run every method on generated tracking problems; writes results.parquet, summary.json
+    and each problem as problems/NNN/scene.toml (runnable by `articula plan`)."""
+    from articula.bench.suite import ARTICULA_METHODS, PEER_METHODS, peers_missing, run_suite
+    from articula.errors import ConfigError
+    from articula.runs.folders import check_out
+
+    missing = peers_missing()
+    if methods is None:
+        chosen = list(ARTICULA_METHODS) + ([] if missing else list(PEER_METHODS))
+    else:
+        chosen = [m.strip() for m in methods.split(",") if m.strip()]
+        unknown = [m for m in chosen if m not in ARTICULA_METHODS + PEER_METHODS]
+        if unknown or not chosen:
+            known = ", ".join(ARTICULA_METHODS + PEER_METHODS)
+            raise ConfigError(
+                "--methods", f"unknown {unknown or 'none given'}; choose from {known}"
+            )
+        if missing and any(m in PEER_METHODS for m in chosen):
+            raise ConfigError("--methods", f"mink cannot run: {missing}")
+    table = robot_table(robot)
+    check_out(out_dir, "suite", force)
+    with progress_bar(as_json) as bar:
+        task = bar.add_task("suite", total=problems)
+        summary = run_suite(
+            table, problems, seed, out_dir, chosen, workers=workers, dask=dask, force=force,
+            progress=lambda done, total: bar.update(task, completed=done),
+        )  # fmt: skip
+    summary["results"] = str(out_dir / "results.parquet")
+    if missing and methods is None:
+        summary["peers_skipped"] = missing
+    if as_json:
+        emit_json(summary)
+        return
+    _print(summary)
+
+
+def robot_table(robot: str) -> dict[str, Any]:
+    """The [robot] table of --robot: a built-in name, a URDF file or a TOML file's [robot]
+    table, paths made absolute."""
+    from articula.errors import ConfigError
+    from articula.validation import load_toml
+
+    path = Path(robot)
+    if path.suffix.lower() == ".urdf":
+        if not path.is_file():
+            raise ConfigError("--robot", f"no URDF file {path}")
+        return {"urdf": str(path.resolve())}
+    if path.suffix.lower() == ".toml":
+        data = load_toml(path)
+        if not isinstance(data.get("robot"), dict):
+            raise ConfigError("--robot", f"{path} has no [robot] table")
+        table = dict(data["robot"])
+        base = path.resolve().parent
+        if "urdf" in table:
+            table["urdf"] = str((base / table["urdf"]).resolve())
+        if "package_dirs" in table:
+            table["package_dirs"] = [str((base / d).resolve()) for d in table["package_dirs"]]
+        return table
+    return {"builtin": robot}
+
+
+def _print(summary: dict[str, Any]) -> None:
+    """The summary as a table, one row per method."""
+    from rich.table import Table
+
+    table = Table(title=f"{summary['problems']} problems, seed {summary['seed']}: success = no "
+                  "collision, limits kept, RMS < 1 mm after 1 s")  # fmt: skip
+    for name in ("method", "success", "median µs", "p99 µs", "RMS mm", "min clear. mm",
+                 "failures"):  # fmt: skip
+        table.add_column(name, justify="left" if name in ("method", "failures") else "right")
+    for method, m in summary["methods"].items():
+        failures = ", ".join(f"{k} {v}" for k, v in m["failures"].items() if v) or "—"
+        table.add_row(
+            method, f"{100 * m['success_rate']:.0f} %", _number(m["median_step_us"], 0),
+            _number(m["p99_step_us"], 0), _number(m["median_rms_error_m"], 3, 1e3),
+            _number(m["min_clearance_m"], 1, 1e3), failures,
+        )  # fmt: skip
+    out.print(table)
+    if "peers_skipped" in summary:
+        out.print(f"mink skipped: {summary['peers_skipped']}")
+    out.print(f"results in {summary['results']}")
+
+
+def _number(value: float | None, digits: int, scale: float = 1.0) -> str:
+    """A number for the table, — when there is none."""
+    return "—" if value is None else f"{scale * value:.{digits}f}"
