@@ -30,6 +30,7 @@ LAYERS = {
     "runs": 9,
     "book": 10,
     "bench": 10,
+    "viewer": 10,
     "cli": 11,
     "__main__": 12,
 }

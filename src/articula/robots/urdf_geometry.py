@@ -45,9 +45,9 @@ def collision_shapes(
             if geometry is None or len(geometry) == 0:
                 raise ModelError(f"{urdf}: link {name!r} has a <collision> without <geometry>")
             where = f"{urdf}: link {name!r} collision {i}"
-            origin = _origin(element.find("origin"), where)
+            placement = origin(element.find("origin"), where)
             for shape in _shapes(geometry[0], urdf, package_dirs, where, name in chosen):
-                shapes.setdefault(name, []).append((shape, origin))
+                shapes.setdefault(name, []).append((shape, placement))
     return shapes
 
 
@@ -93,7 +93,7 @@ def _shapes(
     try:
         if element.tag == "mesh":
             path = resolve_mesh_path(element.get("filename", ""), urdf, package_dirs)
-            scale = _floats(element.get("scale", "1 1 1"), 3, where)
+            scale = floats(element.get("scale", "1 1 1"), 3, where)
             mesh = load_mesh(path, scale)
             if decompose:
                 if len(mesh.vertices) > MAX_DECOMPOSE_VERTICES:  # its run would take long
@@ -107,7 +107,7 @@ def _shapes(
                 return convex_parts(mesh, str(path), decompose=True)
             return mesh_parts(mesh, str(path))
         if element.tag == "box":
-            return [box(_floats(element.get("size", ""), 3, where))]
+            return [box(floats(element.get("size", ""), 3, where))]
         if element.tag == "cylinder":
             return [
                 cylinder(float(element.get("radius", "nan")), float(element.get("length", "nan")))
@@ -137,16 +137,18 @@ def mesh_parts(mesh: trimesh.Trimesh, name: str) -> list[ConvexShape]:
     return [convex_hull(mesh.vertices, name)]
 
 
-def _origin(element: ET.Element | None, where: str) -> np.ndarray:
+def origin(element: ET.Element | None, where: str) -> np.ndarray:
+    """The pose (4×4) an <origin> element gives (identity without one)."""
     if element is None:
         return np.eye(4)
     return pose(
-        _floats(element.get("xyz", "0 0 0"), 3, where),
-        _floats(element.get("rpy", "0 0 0"), 3, where),
+        floats(element.get("xyz", "0 0 0"), 3, where),
+        floats(element.get("rpy", "0 0 0"), 3, where),
     )
 
 
-def _floats(text: str, count: int, where: str) -> tuple[float, ...]:
+def floats(text: str, count: int, where: str) -> tuple[float, ...]:
+    """`count` numbers from a URDF attribute; ModelError naming `where` otherwise."""
     try:
         values = tuple(float(v) for v in text.split())
     except ValueError:

@@ -1,0 +1,1 @@
+"""The browser viewer (viser): replay a planner's run; steer a live one."""

@@ -1,0 +1,81 @@
+"""What the viewer puts in a viser scene: links, obstacles, paths, the closest pair; and the
+colour of a link by its clearance."""
+
+from __future__ import annotations
+
+import numpy as np
+import trimesh
+import viser
+from scipy.spatial.transform import Rotation
+
+from articula.robots.urdf_visuals import Visual
+from articula.scene.scene import Scene
+
+ROBOT_COLOUR = (255, 140, 0)  # orange: what the browser tests look for
+OBSTACLE_COLOUR = (120, 120, 130)
+REFERENCE_COLOUR = (40, 110, 230)
+PATH_COLOUR = (20, 170, 60)
+CLOSEST_COLOUR = (220, 30, 30)
+NEAR = 0.05  # [m] a link closer than this to an obstacle is shaded toward red
+
+
+def wxyz_position(T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """viser's (quaternion w, x, y, z; position) of a 4×4 pose."""
+    x, y, z, w = Rotation.from_matrix(T[:3, :3]).as_quat()
+    return np.array([w, x, y, z]), T[:3, 3].copy()
+
+
+def clearance_colour(d: float, d_min: float) -> tuple[int, int, int]:
+    """The robot's colour far from obstacles, shading to red at d_min (and red below)."""
+    if not np.isfinite(d) or d >= NEAR:
+        return ROBOT_COLOUR
+    s = float(np.clip((d - d_min) / max(NEAR - d_min, 1e-9), 0.0, 1.0))
+    red = np.array(CLOSEST_COLOUR)
+    return tuple(int(v) for v in red + s * (np.array(ROBOT_COLOUR) - red))  # type: ignore[return-value]
+
+
+def add_robot(
+    server: viser.ViserServer, visuals: dict[str, list[Visual]]
+) -> tuple[dict[str, viser.FrameHandle], dict[str, list]]:
+    """A frame per link (/robot/<link>) with its meshes; (frames, meshes) by link name."""
+    frames, meshes = {}, {}
+    for link, items in visuals.items():
+        frames[link] = server.scene.add_frame(f"/robot/{link}", show_axes=False)
+        meshes[link] = []
+        for i, visual in enumerate(items):
+            wxyz, position = wxyz_position(visual.placement)
+            meshes[link].append(server.scene.add_mesh_simple(
+                f"/robot/{link}/visual_{i}", np.asarray(visual.mesh.vertices, dtype=np.float32),
+                np.asarray(visual.mesh.faces, dtype=np.uint32), color=ROBOT_COLOUR,
+                wxyz=wxyz, position=position,
+            ))  # fmt: skip
+    return frames, meshes
+
+
+def add_obstacles(
+    server: viser.ViserServer, scene: Scene, t: float
+) -> dict[str, viser.FrameHandle]:
+    """A frame per obstacle (/obstacles/<name>) at its pose at time t [s], its convex parts as
+    meshes; the frames by name."""
+    frames = {}
+    for obstacle in scene.obstacles:
+        wxyz, position = wxyz_position(obstacle.pose_at(t))
+        frames[obstacle.name] = server.scene.add_frame(
+            f"/obstacles/{obstacle.name}", show_axes=False, wxyz=wxyz, position=position
+        )
+        for i, part in enumerate(obstacle.parts):
+            hull = trimesh.convex.convex_hull(part.vertices)
+            server.scene.add_mesh_simple(
+                f"/obstacles/{obstacle.name}/part_{i}", np.asarray(hull.vertices, np.float32),
+                np.asarray(hull.faces, np.uint32), color=OBSTACLE_COLOUR, opacity=0.8,
+            )  # fmt: skip
+    return frames
+
+
+def add_path(server: viser.ViserServer, name: str, points: np.ndarray, colour: tuple) -> None:
+    """A polyline through `points` (n × 3) [m] as line segments."""
+    if len(points) < 2:
+        return
+    segments = np.stack([points[:-1], points[1:]], axis=1).astype(np.float32)
+    server.scene.add_line_segments(name, segments, colour, thickness=3.0,
+                                   thickness_units="screen")  # fmt: skip

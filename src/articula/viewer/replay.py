@@ -1,0 +1,160 @@
+"""`articula view`: a planner's run replayed in the browser (viser).
+
+The page shows the links (their URDF visual meshes, else collision hulls) coloured by
+clearance, the obstacles, the reference path (blue) and the achieved end-effector path
+(green), and at the current time the closest link-obstacle pair as a red segment between its
+witness points with its distance. The panel has a run picker (a sweep folder), a time slider,
+play/pause and speed, and plots of error and clearance against time.
+"""
+
+from __future__ import annotations
+
+import socket
+import time
+from pathlib import Path
+
+import numpy as np
+import viser
+import viser.uplot as uplot
+
+from articula.errors import ConfigError
+from articula.viewer import drawing
+from articula.viewer.run_data import RunData, load_run, run_folders
+
+SPEEDS = ("0.25", "0.5", "1", "2", "4")
+FRAME_S = 1.0 / 30.0  # [s] between frames while playing
+CAMERA = (1.6, -1.6, 1.3)  # [m] where a new tab's camera starts, looking at LOOK_AT
+LOOK_AT = (0.0, 0.0, 0.5)
+
+
+class Replay:
+    """The replay of the runs in a folder, in one viser server (every browser tab sees the same
+    state)."""
+
+    def __init__(self, server: viser.ViserServer, runs: list[Path]) -> None:
+        self.server = server
+        self.runs = {path.name: path for path in runs}
+        gui = server.gui
+        self.picker = gui.add_dropdown("run", tuple(self.runs), initial_value=runs[0].name,
+                                       visible=len(runs) > 1)  # fmt: skip
+        self.slider = gui.add_slider("time [s]", 0.0, 1.0, 0.01, 0.0)
+        self.playing = gui.add_checkbox("play", False)
+        self.speed = gui.add_dropdown("speed", SPEEDS, initial_value="1")
+        self.status = gui.add_markdown("")
+        self.plots: list = []
+        self.run: RunData | None = None
+        self.index = 0
+        self.picker.on_update(lambda _: self.load(self.runs[self.picker.value]))
+        self.slider.on_update(lambda _: self.show(self._index_at(self.slider.value)))
+        server.initial_camera.position = CAMERA
+        server.initial_camera.look_at = LOOK_AT
+        self.load(runs[0])
+
+    def load(self, folder: Path) -> None:
+        """Show the run in `folder` from its start."""
+        run = load_run(folder)
+        self.run = run
+        scene = self.server.scene
+        scene.reset()
+        scene.add_grid("/grid", width=2.0, height=2.0, cell_size=0.1)
+        self.frames, self.meshes = drawing.add_robot(self.server, run.visuals)
+        self.obstacles = drawing.add_obstacles(self.server, run.scene, float(run.t[0]))
+        drawing.add_path(self.server, "/reference", run.x_ref, drawing.REFERENCE_COLOUR)
+        drawing.add_path(self.server, "/achieved", run.x, drawing.PATH_COLOUR)
+        self.closest_line = None
+        self.closest_label = None
+        self.slider.max = float(run.t[-1])
+        self.slider.step = float(run.t[1] - run.t[0]) if len(run.t) > 1 else 0.01
+        for plot in self.plots:
+            plot.remove()
+        self.plots = [
+            self._plot("error [mm]", run.t, 1e3 * run.error),
+            self._plot("clearance [mm]", run.t, 1e3 * np.where(np.isfinite(run.clearance),
+                                                                run.clearance, np.nan)),
+        ]  # fmt: skip
+        self.show(0)
+
+    def show(self, k: int) -> None:
+        """Put the arm, the obstacles and the closest pair at sample k."""
+        run = self.run
+        assert run is not None
+        self.index = k
+        for name, T in run.link_poses(k).items():
+            wxyz, position = drawing.wxyz_position(T)
+            self.frames[name].wxyz, self.frames[name].position = wxyz, position
+        for name, T in run.obstacle_poses(k).items():
+            wxyz, position = drawing.wxyz_position(T)
+            self.obstacles[name].wxyz, self.obstacles[name].position = wxyz, position
+        for name, d in run.link_clearances(k).items():
+            for mesh in self.meshes.get(name, ()):
+                mesh.color = drawing.clearance_colour(d, run.d_min)
+        closest = run.closest(k)
+        text = f"t = {run.t[k]:.2f} s · error {1e3 * run.error[k]:.2f} mm"
+        if closest is not None:
+            points = np.array([[closest.on_link, closest.on_obstacle]], dtype=np.float32)
+            self.closest_line = self.server.scene.add_line_segments(
+                "/closest", points, drawing.CLOSEST_COLOUR, thickness=4.0,
+                thickness_units="screen")  # fmt: skip
+            self.closest_label = self.server.scene.add_label(
+                "/closest/label", f"{1e3 * closest.distance:.1f} mm",
+                position=(closest.on_link + closest.on_obstacle) / 2)  # fmt: skip
+            text += (f" · closest: {closest.link} – {closest.obstacle}, "
+                     f"{1e3 * closest.distance:.1f} mm")  # fmt: skip
+        self.status.content = text
+
+    def tick(self, elapsed: float) -> None:
+        """Advance by `elapsed` [s] of wall time times the speed while playing."""
+        run = self.run
+        if run is None or not self.playing.value:
+            return
+        t = float(run.t[self.index]) + elapsed * float(self.speed.value)
+        if t > run.t[-1]:
+            t = float(run.t[0])  # loop
+        self.slider.value = t
+        self.show(self._index_at(t))
+
+    def _index_at(self, t: float) -> int:
+        """The sample at time t [s] (the last one at or before it)."""
+        assert self.run is not None
+        return int(np.clip(np.searchsorted(self.run.t, t + 1e-9) - 1, 0, len(self.run.t) - 1))
+
+    def _plot(self, label: str, t: np.ndarray, values: np.ndarray):
+        """A small uPlot of one series against time."""
+        return self.server.gui.add_uplot(
+            data=(t, values),
+            series=(uplot.Series(label="t [s]"), uplot.Series(label=label, stroke="#d9480f")),
+            scales={"x": uplot.Scale(time=False)}, title=label, aspect=2.0,
+        )  # fmt: skip
+
+
+def open_server(host: str, port: int) -> viser.ViserServer:
+    """A viser server on host:port; ConfigError naming --port when it is taken."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            probe.bind((host, port))
+        except OSError as exc:
+            raise ConfigError("--port", f"cannot listen on {host}:{port} ({exc.strerror}); "
+                              "choose another port") from None  # fmt: skip
+    return viser.ViserServer(host=host, port=port, verbose=False)
+
+
+def serve(folder: Path, host: str, port: int, announce) -> None:
+    """Serve the replay of `folder` until Ctrl-C (a normal end: it returns); announce(url)
+    once it listens."""
+    runs = run_folders(folder)
+    load_run(runs[0])  # a bad run fails before the server starts
+    server = open_server(host, port)
+    try:
+        replay = Replay(server, runs)
+        announce(f"http://{host}:{port}")
+        last = time.monotonic()
+        while True:
+            time.sleep(FRAME_S)
+            now = time.monotonic()
+            replay.tick(now - last)
+            last = now
+    except KeyboardInterrupt:
+        return
+    finally:
+        server.stop()

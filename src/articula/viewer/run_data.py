@@ -1,0 +1,156 @@
+"""A planner's run folder read for display: its scene, trace, and what each link looks like."""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pyarrow.parquet as pq
+import trimesh
+
+from articula.errors import ArticulaError, ConfigError
+from articula.robots.model import BUILTIN
+from articula.robots.urdf_visuals import Visual, visual_meshes
+from articula.runs.folders import CONFIG, TRACE
+from articula.scene.config import build_scene, load_scene_spec
+from articula.scene.scene import Scene
+
+PLAN = "baornn.plan"
+
+
+@dataclass(frozen=True)
+class Closest:
+    """The closest link-obstacle pair at one time: names, witness points [m, world] and the
+    signed distance [m]."""
+
+    link: str
+    obstacle: str
+    on_link: np.ndarray
+    on_obstacle: np.ndarray
+    distance: float
+
+
+@dataclass
+class RunData:
+    """What `articula view` shows of one run: the scene rebuilt from its config.toml, the
+    trace's time series (t [s], q [rad], x and x_ref [m], error and clearance [m]) and the
+    links' meshes (visual where the URDF has them, else the collision hulls)."""
+
+    folder: Path
+    scene: Scene
+    t: np.ndarray
+    q: np.ndarray
+    x: np.ndarray
+    x_ref: np.ndarray
+    error: np.ndarray
+    clearance: np.ndarray
+    visuals: dict[str, list[Visual]]
+    d_min: float
+
+    def link_poses(self, k: int) -> dict[str, np.ndarray]:
+        """Pose (4×4, world) of every link with something to draw, at sample k."""
+        poses = self.scene.robot.link_poses(self.q[k])
+        return {name: poses[name] for name in self.visuals if name in poses}
+
+    def obstacle_poses(self, k: int) -> dict[str, np.ndarray]:
+        """Pose (4×4, world) of every obstacle at sample k."""
+        return {o.name: o.pose_at(float(self.t[k])) for o in self.scene.obstacles}
+
+    def link_clearances(self, k: int) -> dict[str, float]:
+        """Each link's smallest distance [m] to any obstacle at sample k (+inf without any)."""
+        if not self.scene.obstacles:
+            return {link.name: np.inf for link in self.scene.robot.links}
+        d = self.scene.distances(self.q[k], float(self.t[k]))
+        return {link.name: float(d[i].min()) for i, link in enumerate(self.scene.robot.links)}
+
+    def closest(self, k: int) -> Closest | None:
+        """The closest link-obstacle pair at sample k, None without obstacles."""
+        if not self.scene.obstacles:
+            return None
+        w = self.scene.witnesses(self.q[k], float(self.t[k]))
+        li, oi = np.unravel_index(int(np.argmin(w.distance)), w.distance.shape)
+        return Closest(self.scene.robot.links[li].name, self.scene.obstacles[oi].name,
+                       w.on_link[li, oi].copy(), w.on_obstacle[li, oi].copy(),
+                       float(w.distance[li, oi]))  # fmt: skip
+
+
+class RunFolderError(ConfigError):
+    """A folder `view` cannot show (no trace, not a planner's run)."""
+
+
+def run_folders(folder: Path) -> list[Path]:
+    """The planner runs in `folder`: itself when it is one, else a sweep's run folders that are
+    (sorted); RunFolderError when there is none."""
+    if not folder.is_dir():
+        raise RunFolderError("RUN_DIR", f"{folder} is not a folder")
+    if (folder / CONFIG).is_file() or (folder / TRACE).is_file():
+        return [folder]
+    runs = sorted(p for p in folder.iterdir() if p.is_dir() and _is_plan(p))
+    if not runs:
+        raise RunFolderError(
+            "RUN_DIR", f"{folder} holds no planner run (a folder with config.toml and "
+            "trace.parquet written by `articula plan`, or a sweep of them)"
+        )  # fmt: skip
+    return runs
+
+
+def _is_plan(folder: Path) -> bool:
+    """Whether `folder` is a planner's run folder."""
+    try:
+        config = tomllib.loads((folder / CONFIG).read_text())
+    except (OSError, ValueError):
+        return False
+    return config.get("experiment") == PLAN and (folder / TRACE).is_file()
+
+
+def load_run(folder: Path) -> RunData:
+    """The run in `folder`; RunFolderError naming what is missing."""
+    try:
+        config = tomllib.loads((folder / CONFIG).read_text())
+    except FileNotFoundError:
+        raise RunFolderError("RUN_DIR", f"{folder} has no {CONFIG}: not a run folder") from None
+    except (OSError, ValueError) as exc:
+        raise RunFolderError("RUN_DIR", f"cannot read {folder / CONFIG} ({exc})") from None
+    if config.get("experiment") != PLAN:
+        raise RunFolderError(
+            "RUN_DIR", f"{folder} is a run of {config.get('experiment')!r}; view shows {PLAN} "
+            "runs (articula plan)"
+        )  # fmt: skip
+    try:
+        trace = pq.read_table(folder / TRACE).to_pydict()
+    except (OSError, ValueError) as exc:
+        raise RunFolderError("RUN_DIR", f"{folder} has no readable {TRACE} ({exc})") from None
+    scene, _ = build_scene(load_scene_spec(config), folder)
+    nq = scene.robot.nq
+    column = lambda *names: np.column_stack([trace[n] for n in names])  # noqa: E731
+    return RunData(
+        folder=folder, scene=scene, t=np.asarray(trace["t"]),
+        q=column(*(f"q_{i + 1}" for i in range(nq))), x=column("x", "y", "z"),
+        x_ref=column("x_ref", "y_ref", "z_ref"), error=np.asarray(trace["error"]),
+        clearance=np.asarray(trace["clearance"]), visuals=_visuals(config["robot"], scene),
+        d_min=float(config.get("planner", {}).get("d_min", 0.0)),
+    )  # fmt: skip
+
+
+def _visuals(robot: dict, scene: Scene) -> dict[str, list[Visual]]:
+    """The URDF's visual meshes of the scene's links, or their collision hulls when the URDF
+    has none or they cannot be read."""
+    if "builtin" in robot:
+        relative = BUILTIN[robot["builtin"]][0]
+        urdf = Path(str(resources.files("articula.robots") / "data" / relative))
+    else:
+        urdf = Path(robot["urdf"])
+    try:
+        visuals = visual_meshes(urdf, [Path(d) for d in robot.get("package_dirs", [])])
+    except ArticulaError:
+        visuals = {}
+    model = scene.robot.model
+    drawn = {name: v for name, v in visuals.items() if model.existFrame(name) and v}
+    if drawn:
+        return drawn
+    return {link.name: [Visual(trimesh.convex.convex_hull(shape.vertices), T, None)
+                        for shape, T in zip(link.shapes, link.placements, strict=True)]
+            for link in scene.robot.links}  # fmt: skip

@@ -1,0 +1,127 @@
+"""Fixtures of the viewer tests: a planned run, a free port, the viewer as a real process and
+Debian's Chromium driven by Playwright."""
+
+from __future__ import annotations
+
+import io
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+import tomli_w
+
+from articula.validation import load_toml
+
+CHROMIUM_INSTALL = "apt-get install -y chromium"
+CONFIGS = Path(__file__).resolve().parents[2] / "src/articula/book/ch1/configs"
+ORANGE = np.array([255, 140, 0])  # viewer.drawing.ROBOT_COLOUR, shaded by the lights
+
+
+@pytest.fixture(scope="session")
+def chromium() -> str:
+    """The path of Debian's Chromium (skip without it)."""
+    path = shutil.which("chromium") or shutil.which("chromium-browser")
+    if path is None:
+        pytest.skip(CHROMIUM_INSTALL)
+    return path
+
+
+@pytest.fixture(scope="session")
+def planned_run(tmp_path_factory) -> Path:
+    """A 3 s qp run of the book's two-obstacle circle, written by `articula plan`."""
+    folder = tmp_path_factory.mktemp("view")
+    config = load_toml(CONFIGS / "circle_two_obstacles.toml")
+    for obstacle in config["obstacles"]:
+        obstacle["mesh"] = str(CONFIGS / obstacle["mesh"])
+    config["planner"] |= {"method": "qp", "duration": 3.0, "settle": 1.0}
+    (folder / "scene.toml").write_text(tomli_w.dumps(config))
+    articula = Path(sys.executable).parent / "articula"
+    proc = subprocess.run([articula, "plan", folder / "scene.toml", "--out", folder / "run"],
+                          capture_output=True, text=True, timeout=300)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    return folder / "run"
+
+
+def free_port() -> int:
+    """A TCP port nothing listens on now."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture
+def viewer() -> Iterator[Callable[..., tuple[subprocess.Popen, str]]]:
+    """viewer(*args) starts `articula <args> --port P` and waits for its URL line; (process,
+    url). Every process started is stopped after the test."""
+    started: list[subprocess.Popen] = []
+
+    def start(*args: object) -> tuple[subprocess.Popen, str]:
+        port = free_port()
+        articula = Path(sys.executable).parent / "articula"
+        command = [articula, *map(str, args), "--port", str(port)]
+        proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        started.append(proc)
+        deadline = time.monotonic() + 120
+        assert proc.stdout is not None
+        for line in proc.stdout:
+            if f"http://127.0.0.1:{port}" in line and "viewer at" in line:
+                return proc, f"http://127.0.0.1:{port}"
+            assert time.monotonic() < deadline, "the viewer did not start"
+        raise AssertionError(f"the viewer exited: {proc.wait()} {proc.stderr.read()}")
+
+    yield start
+    for proc in started:
+        if proc.poll() is None:
+            proc.send_signal(signal.SIGINT)
+            try:
+                proc.wait(10)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+
+
+@pytest.fixture
+def browser(chromium):
+    """A headless Chromium (software WebGL) under Playwright."""
+    sync_api = pytest.importorskip("playwright.sync_api", reason="pip install -e '.[dev]'")
+    with sync_api.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=chromium, args=[
+            "--no-sandbox", "--use-gl=angle", "--use-angle=swiftshader",
+            "--enable-unsafe-swiftshader"])  # fmt: skip
+        yield b
+        if b.is_connected():
+            b.close()
+
+
+def open_page(browser, url: str):
+    """A 1280×800 tab on the viewer, connected and drawn."""
+    page = browser.new_page(viewport={"width": 1280, "height": 800})
+    page.goto(url)
+    page.get_by_text("Connected").wait_for(timeout=60_000)
+    page.get_by_text("closest:").wait_for(timeout=60_000)
+    time.sleep(3.0)  # software WebGL draws a few frames
+    return page
+
+
+def screenshot(page) -> np.ndarray:
+    """The tab as an RGB array (rows, columns, 3)."""
+    from PIL import Image
+
+    return np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB")).astype(int)
+
+
+def robot_mask(image: np.ndarray) -> np.ndarray:
+    """Pixels of the robot's orange (any shade the lights give it): red high, green between,
+    blue low."""
+    r, g, b = image[..., 0], image[..., 1], image[..., 2]
+    return (r > 120) & (g > 0.35 * r) & (g < 0.8 * r) & (b < 0.35 * r)
+
+
+os.environ.setdefault("PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD", "1")

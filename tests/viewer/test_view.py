@@ -1,0 +1,67 @@
+"""`articula view` in a real headless Chromium: the arm renders, the slider moves it, the plots
+are there; two tabs; closing the browser leaves the server up; Ctrl-C stops it; bad folders
+and taken ports are one line, exit 2."""
+
+from __future__ import annotations
+
+import signal
+import socket
+import urllib.request
+
+import numpy as np
+
+from tests.viewer.conftest import free_port, open_page, robot_mask, screenshot
+
+
+def test_a_run_renders_and_the_slider_moves_the_arm(planned_run, viewer, browser, tmp_path):
+    _, url = viewer("view", planned_run)
+    page = open_page(browser, url)
+    first = screenshot(page)
+    assert first.std() > 10  # not a blank page
+    arm = robot_mask(first[:, :900])  # the 3-D view, left of the panel
+    assert arm.sum() > 2000, arm.sum()
+    assert page.locator(".uplot").count() == 2  # error and clearance plots
+    time_box = page.locator("input[inputmode='decimal']:visible").first  # the slider's box
+    time_box.fill("2.5")
+    time_box.press("Enter")
+    page.get_by_text("t = 2.50 s").wait_for(timeout=30_000)
+    page.wait_for_timeout(2000)
+    second = screenshot(page)
+    moved = robot_mask(second[:, :900]) ^ arm
+    assert moved.sum() > 300, moved.sum()  # the arm is elsewhere in the picture
+    (tmp_path / "view.png").write_bytes(page.screenshot())
+
+
+def test_two_tabs_and_a_closed_browser_leave_the_server_serving(planned_run, viewer, browser):
+    proc, url = viewer("view", planned_run)
+    pages = [open_page(browser, url) for _ in range(2)]
+    for page in pages:
+        assert robot_mask(screenshot(page)[:, :900]).sum() > 2000
+    browser.close()
+    assert proc.poll() is None
+    with urllib.request.urlopen(url, timeout=10) as response:
+        assert response.status == 200
+
+
+def test_ctrl_c_stops_the_viewer(planned_run, viewer):
+    proc, _ = viewer("view", planned_run)
+    proc.send_signal(signal.SIGINT)
+    assert proc.wait(15) == 0  # the normal way to stop a server
+    assert "Traceback" not in proc.stderr.read()
+
+
+def test_a_folder_without_a_run_is_one_line_and_exit_2(tmp_path, cli):
+    proc = cli("view", tmp_path, "--port", str(free_port()))
+    assert proc.returncode == 2
+    assert len(proc.stderr.strip().splitlines()) == 1 and "RUN_DIR" in proc.stderr
+
+
+def test_a_taken_port_is_one_line_and_exit_2(planned_run, cli):
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        proc = cli("view", planned_run, "--port", str(port))
+    assert proc.returncode == 2
+    assert len(proc.stderr.strip().splitlines()) == 1 and "--port" in proc.stderr
+    assert np.isfinite(port)
