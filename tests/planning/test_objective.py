@@ -9,7 +9,7 @@ import pytest
 
 from articula.errors import ConfigError
 from articula.geometry.poses import pose
-from articula.geometry.shapes import sphere
+from articula.geometry.shapes import cylinder
 from articula.planning.objective import Objective
 from articula.scene import Obstacle, Scene
 from tests.planning.helpers import FREE, Q_BENT, ROBOT, ball
@@ -58,8 +58,8 @@ def test_a_point_inside_an_obstacle_is_outside_omega_on_both_paths():
 
 
 def test_a_scene_without_a_compiled_form_is_evaluated_with_coal():
-    moving = Obstacle("m", (sphere(0.05),), lambda t: pose([0.3, 0.3, 0.5 + 0.01 * t]))
-    scene = Scene(ROBOT, [moving])
+    round_rim = Obstacle("c", (cylinder(0.05, 0.2),), pose([0.3, 0.3, 0.5]))
+    scene = Scene(ROBOT, [round_rim])
     objective = Objective(scene, 0.001, 1.0, 0.0)
     assert objective.compiled is None
     q = np.zeros(ROBOT.nq)

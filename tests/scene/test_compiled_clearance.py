@@ -58,11 +58,22 @@ def test_warm_start_does_not_change_the_answer():
     assert np.allclose(first, again, atol=1e-9, rtol=0)
 
 
-def test_moving_obstacles_and_cylinders_have_no_compiled_form():
-    moving = Obstacle("m", (sphere(0.05),), lambda t: pose([0.3, 0.3, 0.5 + 0.01 * t]))
-    assert CompiledClearance.build(Scene(ROBOT, [moving])) is None
+def test_cylinders_have_no_compiled_form():
     round_rim = Obstacle("c", (cylinder(0.05, 0.2),), pose([0.3, 0.3, 0.5]))
     assert CompiledClearance.build(Scene(ROBOT, [round_rim])) is None
+
+
+def test_a_moving_obstacle_is_where_its_pose_puts_it_at_each_time():
+    # A box sweeping past the arm, and one at rest: the compiled distance follows the box
+    # (at(t)) as coal's does, also when a time comes back.
+    moving = Obstacle("m", (box((0.1, 0.2, 0.1)),), lambda t: pose([0.2 + 0.1 * t, 0.4, 0.6]))
+    still = Obstacle("s", (sphere(0.05),), pose([-0.4, 0.0, 0.9]))
+    scene = Scene(ROBOT, [moving, still])
+    compiled = CompiledClearance.build(scene)
+    q = np.array([0.3, 0.5, 0.0, -1.0, 0.0, 0.6, 0.0])
+    for t in (0.0, 1.0, 2.5, 4.0, 1.0):
+        compiled.at(t)
+        assert compiled.evaluate(q)[0] == pytest.approx(scene.min_distance(q, t), abs=1e-7)
 
 
 def test_self_pairs_agree_with_coal_and_stay_apart_from_obstacles():

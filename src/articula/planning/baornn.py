@@ -92,7 +92,7 @@ class Baornn(BeetleSearch):
             self.iterations += 1
             return kernel.iterations(q, g, target.position, obj.orient_arguments(target),
                                      b[None, :], self.params.c1, self.params.c2,
-                                     *obj.kernel_arguments(self._box))  # fmt: skip
+                                     *obj.kernel_arguments(self._box, t))  # fmt: skip
         b /= math.sqrt(b @ b)  # a normalised random direction
         lam = self.params.c1 * np.sqrt(g) if np.isfinite(g) else self.params.c1  # Eq. (1.23)
         # Eqs. (1.15)-(1.18): antennae, projected onto Ω, evaluated by "virtual robots".
@@ -120,7 +120,7 @@ class Baornn(BeetleSearch):
             self.iterations += k
             q, _ = kernel.iterations(q, g, target.position, obj.orient_arguments(target),
                                      directions, self.params.c1, self.params.c2,
-                                     *obj.kernel_arguments(self._box))  # fmt: skip
+                                     *obj.kernel_arguments(self._box, t))  # fmt: skip
             return self._end_period(start, q)
         for _ in range(k):
             q, g = self.iterate(q, g, target, t)

@@ -51,7 +51,7 @@ class ImprovedBaornn(BeetleSearch):
         obj, p = self.objective, self.params
         draw = self.rng.standard_normal((q.size, min(p.pairs, q.size)))
         if obj.compiled is not None:
-            return self._compiled(q, g, np.zeros(0), target, draw[None])
+            return self._compiled(q, g, np.zeros(0), target, draw[None], t)
         lam = p.c1 * math.sqrt(obj.tracking_error(q, target))
         # Orthonormal directions: QR of a Gaussian matrix (columns), as many as pairs.
         directions, _ = np.linalg.qr(draw)
@@ -95,7 +95,7 @@ class ImprovedBaornn(BeetleSearch):
             # The same draws as iterations_per_step calls of iterate, in one compiled call.
             draws = self.rng.standard_normal((p.iterations_per_step, q.size, min(p.pairs, q.size)))
             warm = np.zeros(0) if self._last_motion is None else self._last_motion
-            q, _ = self._compiled(q, math.nan, warm, target, draws)
+            q, _ = self._compiled(q, math.nan, warm, target, draws, t)
         else:
             g = self.objective.value(q, target, t)
             if self._last_motion is not None:
@@ -111,13 +111,19 @@ class ImprovedBaornn(BeetleSearch):
         return self._end_period(start, q)
 
     def _compiled(
-        self, q: np.ndarray, g: float, warm: np.ndarray, target: Target, draws: np.ndarray
+        self,
+        q: np.ndarray,
+        g: float,
+        warm: np.ndarray,
+        target: Target,
+        draws: np.ndarray,
+        t: float,
     ) -> tuple[np.ndarray, float]:
         """From q with g = g(q) (NaN: computed there), a warm start (none when `warm` is empty)
-        and the iterations of `draws` by planning/baornn_kernel.py."""
+        and the iterations of `draws` by planning/baornn_kernel.py, moving obstacles at time t."""
         obj, p = self.objective, self.params
         lambda_weight, beta, d_min, lower, upper, arrays, static_min = obj.kernel_arguments(
-            self._box
+            self._box, t
         )
         q, g, evaluations = kernel.improved_period(
             q, g, warm, target.position, obj.orient_arguments(target), draws, p.c1, p.c2,

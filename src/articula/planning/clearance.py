@@ -47,6 +47,7 @@ class RowSource:
     ) -> tuple[EndEffector, ClearanceRows]:
         """(the end effector, the rows closer than `influence` [m]) at q [rad], time t [s]."""
         if self.compiled is not None:
+            self.compiled.at(t)
             out = compiled_rows.clearance_rows(self.compiled, q, influence)
             if out is not None:
                 x, R, J, distance, gradient, self_pair = out

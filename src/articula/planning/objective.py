@@ -45,13 +45,14 @@ class Objective:
         if self.use_compiled:
             object.__setattr__(self, "compiled", CompiledClearance.build(self.scene))
 
-    def kernel_arguments(self, box: Box | None = None) -> tuple:
+    def kernel_arguments(self, box: Box | None = None, t: float = 0.0) -> tuple:
         """Λ, β, d_min, the projection box (default: the joint limits), the compiled scene
         arrays with the pairs that count and their static minima, in the order of
-        planning.baornn_kernel (requires `compiled`)."""
+        planning.baornn_kernel (requires `compiled`), moving obstacles at time t [s]."""
         robot, c = self.scene.robot, self.compiled
         if c is None:
             raise ModelError("this scene has no compiled evaluation (see Objective.compiled)")
+        c.at(t)
         pairs, static_min = c.select(self.needs_obstacles, True)
         if box is not None:
             pairs = c.near_pairs(pairs, box)  # a period's reach: far obstacles drop out
@@ -80,6 +81,7 @@ class Objective:
         """Objective g at configuration q [rad] for the target (or a position [m])."""
         target = as_target(target)
         if self.compiled is not None:
+            self.compiled.at(t)
             d, _, ee, ee_R = self.compiled.evaluate(q, self.needs_obstacles, False)
             return self._combine(self._task_error(target, ee, ee_R), d)
         d = self.scene.clearances(q, t)[0] if self.needs_obstacles else np.inf
@@ -113,6 +115,7 @@ class Objective:
         target = as_target(target)
         clipped = self.scene.robot.clip(q) if box is None else np.clip(q, *box)
         if self.compiled is not None:
+            self.compiled.at(t)
             d, d_self, ee, ee_R = self.compiled.evaluate(clipped, self.needs_obstacles)
             if d <= self.d_min or d_self <= 0:  # Ω: d > d_min (1.12); 0 on overlap
                 return q_current, g_current

@@ -4,10 +4,12 @@ and the smallest link-obstacle clearance, with the same capsule broad phase as S
 One BAORNN iteration evaluates the objective three times; through Pinocchio and coal each
 evaluation is a dozen Python-level calls into C++ (about 1 µs each, see docs/architecture.md).
 Here the whole evaluation is one numba function over arrays taken from the same Scene. It
-covers the common case (revolute joints; polytope, sphere and capsule shapes; obstacles that
-do not move) and `CompiledClearance.build` returns None otherwise, so callers fall back to
-Scene.min_distance. Clearance is GJK distance, and 0 when shapes overlap (no depth); the
-obstacle clearance and the self clearance (the scene's checked link pairs) come out apart.
+covers the common case (revolute joints; polytope, sphere and capsule shapes) and
+`CompiledClearance.build` returns None otherwise, so callers fall back to Scene.min_distance.
+A moving obstacle (a velocity, or a live pose) is put at its pose of time t by `at(t)`
+before the evaluations of that time. Clearance is GJK distance, and 0 when shapes overlap
+(no depth); the obstacle clearance and the self clearance (the scene's checked link pairs)
+come out apart.
 """
 
 from __future__ import annotations
@@ -71,17 +73,18 @@ class CompiledClearance:
     cells: int  # (link, obstacle) cells, row-major, then the checked link pairs in scene order
     static_min: np.ndarray  # (2,) smallest distance of the pairs that never move, per kind
     reach: float  # [m] no shape point is farther than this from any joint origin, in any pose
+    moving_parts: tuple[tuple[int, object], ...] = ()  # (shape, its obstacle) that move
 
     @classmethod
     def build(cls, scene: Scene) -> CompiledClearance | None:
         """The arrays of `scene`, or None when it needs something this path does not cover."""
         model = scene.robot.model
         names = [model.joints[j].shortname() for j in range(1, model.njoints)]
-        if scene.metric != "gjk" or any(o.moving for o in scene.obstacles):
+        if scene.metric != "gjk":
             return None
         if any(name not in _AXES and name != "JointModelRevoluteUnaligned" for name in names):
             return None
-        shapes, joints, poses, owner, part_of = [], [], [], [], []
+        shapes, joints, poses, owner, part_of, moving_parts = [], [], [], [], [], []
         # Without anything to keep clear of only the kinematics are needed: no shape at all.
         for li, link in enumerate(scene.robot.links if scene.has_clearance else ()):
             frame = model.frames[link.frame_id]
@@ -93,6 +96,8 @@ class CompiledClearance:
         n_links = len(shapes)
         for oi, obstacle in enumerate(scene.obstacles):
             for part in obstacle.parts:
+                if obstacle.moving:
+                    moving_parts.append((len(shapes), obstacle))
                 shapes.append(part)
                 joints.append(0)
                 poses.append(obstacle.pose_at(0.0))
@@ -115,7 +120,9 @@ class CompiledClearance:
         pairs += [(a, b, SELF, cell_count - len(scene.self_pairs) + k)
                   for k, (la, lb) in enumerate(scene.self_pairs) for a in range(n_links)
                   for b in range(n_links) if (owner[a], owner[b]) == (la, lb)]  # fmt: skip
-        moving = [pair for pair in pairs if joints[pair[0]] != 0 or joints[pair[1]] != 0]
+        moves = {s for s, _ in moving_parts}
+        moving = [pair for pair in pairs if joints[pair[0]] != 0 or joints[pair[1]] != 0
+                  or pair[1] in moves]  # fmt: skip
         index = {pair: k for k, pair in enumerate(pairs)}
         fixed = [pair for pair in pairs if pair not in moving]
         placements = model.jointPlacements
@@ -147,12 +154,20 @@ class CompiledClearance:
             cells=cell_count,
             static_min=np.full(2, np.inf),
             reach=_reach(placements, poses[:n_links], cores[:n_links]),
+            moving_parts=tuple(moving_parts),
         )
         if fixed:
             q0 = np.zeros(model.nq)
             static = _evaluate(q0, *out.arrays(_pair_rows(fixed, index)), np.full(2, np.inf))
             object.__setattr__(out, "static_min", np.array(static[:2]))
         return out
+
+    def at(self, t: float) -> None:
+        """Put the moving obstacles' shapes at their poses of time t [s] (in place)."""
+        for shape, obstacle in self.moving_parts:
+            T = obstacle.pose_at(t)
+            self.shape_rot[shape] = T[:3, :3]
+            self.shape_p[shape] = T[:3, 3]
 
     no_pairs: ClassVar[np.ndarray] = np.zeros((0, 5), dtype=np.int64)  # kinematics only
 
