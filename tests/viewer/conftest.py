@@ -72,7 +72,7 @@ def viewer() -> Iterator[Callable[..., tuple[subprocess.Popen, str]]]:
         deadline = time.monotonic() + 120
         assert proc.stdout is not None
         for line in proc.stdout:
-            if f"http://127.0.0.1:{port}" in line and "viewer at" in line:
+            if f"http://127.0.0.1:{port} (Ctrl-C stops it)" in line:
                 return proc, f"http://127.0.0.1:{port}"
             assert time.monotonic() < deadline, "the viewer did not start"
         raise AssertionError(f"the viewer exited: {proc.wait()} {proc.stderr.read()}")
@@ -100,12 +100,12 @@ def browser(chromium):
             b.close()
 
 
-def open_page(browser, url: str):
-    """A 1280×800 tab on the viewer, connected and drawn."""
+def open_page(browser, url: str, wait_for: str = "closest:"):
+    """A 1280×800 tab on the viewer, connected and drawn (the panel shows `wait_for`)."""
     page = browser.new_page(viewport={"width": 1280, "height": 800})
     page.goto(url)
     page.get_by_text("Connected").wait_for(timeout=60_000)
-    page.get_by_text("closest:").wait_for(timeout=60_000)
+    page.get_by_text(wait_for).first.wait_for(timeout=60_000)
     time.sleep(3.0)  # software WebGL draws a few frames
     return page
 

@@ -27,3 +27,33 @@ def view(
     from articula.viewer.replay import serve
 
     serve(run_dir, host, port, lambda url: out.print(f"viewer at {url} (Ctrl-C stops it)"))
+
+
+@app.command()
+def live(
+    scene: Annotated[Path, typer.Argument(help="A scene file with [trajectory] and [planner].")],
+    method: Annotated[
+        str | None,
+        typer.Option(help="baornn, baornn-improved, pinv, dls or qp (default: the file's)."),
+    ] = None,
+    port: Port = 8080,
+    host: Host = "127.0.0.1",
+    record: Annotated[
+        Path | None, typer.Option(help="Write what happened as a run folder `view` replays.")
+    ] = None,
+) -> None:
+    """Run the scene's planner in real time in the browser; drag obstacles and the target.
+
+    Example: articula live src/articula/book/ch1/configs/circle_two_obstacles.toml --method qp"""
+    from articula.errors import ConfigError
+    from articula.runs.folders import check_out
+    from articula.viewer.live import METHODS, run_live
+
+    if method is not None and method not in METHODS:
+        raise ConfigError(
+            "--method", f"unknown method {method!r}; choose one of {', '.join(METHODS)}"
+        )
+    if record is not None:
+        check_out(record, "run")
+    run_live(scene, method, host, port, record,
+             lambda url: out.print(f"live at {url} (Ctrl-C stops it)"))  # fmt: skip

@@ -17,6 +17,14 @@ REFERENCE_COLOUR = (40, 110, 230)
 PATH_COLOUR = (20, 170, 60)
 CLOSEST_COLOUR = (220, 30, 30)
 NEAR = 0.05  # [m] a link closer than this to an obstacle is shaded toward red
+CAMERA = (1.6, -1.6, 1.3)  # [m] where a new tab's camera starts, looking at LOOK_AT
+LOOK_AT = (0.0, 0.0, 0.5)
+
+
+def aim_camera(server: viser.ViserServer) -> None:
+    """New tabs look at an arm on the origin from the front right, about 2.5 m away."""
+    server.initial_camera.position = CAMERA
+    server.initial_camera.look_at = LOOK_AT
 
 
 def wxyz_position(T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -55,21 +63,37 @@ def add_robot(
 def add_obstacles(
     server: viser.ViserServer, scene: Scene, t: float
 ) -> dict[str, viser.FrameHandle]:
-    """A frame per obstacle (/obstacles/<name>) at its pose at time t [s], its convex parts as
-    meshes; the frames by name."""
+    """A frame per obstacle (/obstacles/<name>) at its pose at time t [s], with its convex
+    parts; the frames by name."""
     frames = {}
     for obstacle in scene.obstacles:
         wxyz, position = wxyz_position(obstacle.pose_at(t))
         frames[obstacle.name] = server.scene.add_frame(
             f"/obstacles/{obstacle.name}", show_axes=False, wxyz=wxyz, position=position
         )
+    add_obstacle_parts(server, scene)
+    return frames
+
+
+def add_obstacle_parts(server: viser.ViserServer, scene: Scene) -> None:
+    """Every obstacle's convex parts as meshes under its node /obstacles/<name> (a frame, or
+    a drag gizmo in `live`)."""
+    for obstacle in scene.obstacles:
         for i, part in enumerate(obstacle.parts):
             hull = trimesh.convex.convex_hull(part.vertices)
             server.scene.add_mesh_simple(
                 f"/obstacles/{obstacle.name}/part_{i}", np.asarray(hull.vertices, np.float32),
                 np.asarray(hull.faces, np.uint32), color=OBSTACLE_COLOUR, opacity=0.8,
             )  # fmt: skip
-    return frames
+
+
+def pose_of(wxyz: np.ndarray, position: np.ndarray) -> np.ndarray:
+    """The 4×4 pose of viser's (quaternion w, x, y, z; position)."""
+    w, x, y, z = np.asarray(wxyz, dtype=float)
+    T = np.eye(4)
+    T[:3, :3] = Rotation.from_quat([x, y, z, w]).as_matrix()
+    T[:3, 3] = position
+    return T
 
 
 def add_path(server: viser.ViserServer, name: str, points: np.ndarray, colour: tuple) -> None:

@@ -23,8 +23,6 @@ from articula.viewer.run_data import RunData, load_run, run_folders
 
 SPEEDS = ("0.25", "0.5", "1", "2", "4")
 FRAME_S = 1.0 / 30.0  # [s] between frames while playing
-CAMERA = (1.6, -1.6, 1.3)  # [m] where a new tab's camera starts, looking at LOOK_AT
-LOOK_AT = (0.0, 0.0, 0.5)
 
 
 class Replay:
@@ -46,8 +44,7 @@ class Replay:
         self.index = 0
         self.picker.on_update(lambda _: self.load(self.runs[self.picker.value]))
         self.slider.on_update(lambda _: self.show(self._index_at(self.slider.value)))
-        server.initial_camera.position = CAMERA
-        server.initial_camera.look_at = LOOK_AT
+        drawing.aim_camera(server)
         self.load(runs[0])
 
     def load(self, folder: Path) -> None:

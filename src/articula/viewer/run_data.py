@@ -10,15 +10,18 @@ from pathlib import Path
 import numpy as np
 import pyarrow.parquet as pq
 import trimesh
+from scipy.spatial.transform import Rotation
 
 from articula.errors import ArticulaError, ConfigError
 from articula.robots.model import BUILTIN
 from articula.robots.urdf_visuals import Visual, visual_meshes
 from articula.runs.folders import CONFIG, TRACE
 from articula.scene.config import build_scene, load_scene_spec
+from articula.scene.obstacles import Obstacle
 from articula.scene.scene import Scene
 
 PLAN = "baornn.plan"
+TRACK = ("x", "y", "z", "qw", "qx", "qy", "qz")  # a live run's obstacle pose columns
 
 
 @dataclass(frozen=True)
@@ -49,6 +52,7 @@ class RunData:
     clearance: np.ndarray
     visuals: dict[str, list[Visual]]
     d_min: float
+    obstacle_track: dict[str, np.ndarray]  # name -> (samples, 7) x, y, z, qw, qx, qy, qz (live)
 
     def link_poses(self, k: int) -> dict[str, np.ndarray]:
         """Pose (4×4, world) of every link with something to draw, at sample k."""
@@ -56,25 +60,45 @@ class RunData:
         return {name: poses[name] for name in self.visuals if name in poses}
 
     def obstacle_poses(self, k: int) -> dict[str, np.ndarray]:
-        """Pose (4×4, world) of every obstacle at sample k."""
-        return {o.name: o.pose_at(float(self.t[k])) for o in self.scene.obstacles}
+        """Pose (4×4, world) of every obstacle at sample k: the recorded one of a live run,
+        else the scene's."""
+        return {o.name: self._track(o.name, k) if o.name in self.obstacle_track
+                else o.pose_at(float(self.t[k])) for o in self.scene.obstacles}  # fmt: skip
+
+    def _track(self, name: str, k: int) -> np.ndarray:
+        """The recorded pose of obstacle `name` at sample k."""
+        row = self.obstacle_track[name][k]
+        x, y, z, w = row[4], row[5], row[6], row[3]
+        T = np.eye(4)
+        T[:3, :3] = Rotation.from_quat([x, y, z, w]).as_matrix()
+        T[:3, 3] = row[:3]
+        return T
 
     def link_clearances(self, k: int) -> dict[str, float]:
         """Each link's smallest distance [m] to any obstacle at sample k (+inf without any)."""
         if not self.scene.obstacles:
             return {link.name: np.inf for link in self.scene.robot.links}
-        d = self.scene.distances(self.q[k], float(self.t[k]))
+        d = self._scene_at(k).distances(self.q[k], float(self.t[k]))
         return {link.name: float(d[i].min()) for i, link in enumerate(self.scene.robot.links)}
 
     def closest(self, k: int) -> Closest | None:
         """The closest link-obstacle pair at sample k, None without obstacles."""
         if not self.scene.obstacles:
             return None
-        w = self.scene.witnesses(self.q[k], float(self.t[k]))
+        w = self._scene_at(k).witnesses(self.q[k], float(self.t[k]))
         li, oi = np.unravel_index(int(np.argmin(w.distance)), w.distance.shape)
         return Closest(self.scene.robot.links[li].name, self.scene.obstacles[oi].name,
                        w.on_link[li, oi].copy(), w.on_obstacle[li, oi].copy(),
                        float(w.distance[li, oi]))  # fmt: skip
+
+    def _scene_at(self, k: int) -> Scene:
+        """The scene with its obstacles where they were at sample k."""
+        if not self.obstacle_track:
+            return self.scene
+        poses = self.obstacle_poses(k)
+        obstacles = [Obstacle(o.name, o.parts, poses[o.name]) for o in self.scene.obstacles]
+        return Scene(self.scene.robot, obstacles, self.scene.broadphase, self.scene.metric,
+                     self.scene.self_pair_names)  # fmt: skip
 
 
 class RunFolderError(ConfigError):
@@ -130,12 +154,14 @@ def load_run(folder: Path) -> RunData:
         folder=folder, scene=scene, t=np.asarray(trace["t"]),
         q=column(*(f"q_{i + 1}" for i in range(nq))), x=column("x", "y", "z"),
         x_ref=column("x_ref", "y_ref", "z_ref"), error=np.asarray(trace["error"]),
-        clearance=np.asarray(trace["clearance"]), visuals=_visuals(config["robot"], scene),
+        clearance=np.asarray(trace["clearance"]), visuals=visuals_of(config["robot"], scene),
         d_min=float(config.get("planner", {}).get("d_min", 0.0)),
+        obstacle_track={o.name: column(*(f"obstacle_{o.name}_{c}" for c in TRACK))
+                        for o in scene.obstacles if f"obstacle_{o.name}_x" in trace},
     )  # fmt: skip
 
 
-def _visuals(robot: dict, scene: Scene) -> dict[str, list[Visual]]:
+def visuals_of(robot: dict, scene: Scene) -> dict[str, list[Visual]]:
     """The URDF's visual meshes of the scene's links, or their collision hulls when the URDF
     has none or they cannot be read."""
     if "builtin" in robot:

@@ -1,0 +1,253 @@
+"""`articula live`: a scene's planner in real time in the browser, obstacles dragged by hand.
+
+Every control period reads each obstacle's drag gizmo, steps the same OnlineController that
+`articula plan` uses (its obstacles live), and moves the arm on the page. The end-effector
+target follows the scene's trajectory or a gizmo of its own; the method, Λ and d_min can be
+changed from the panel (the controller is rebuilt from the arm's current configuration).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import viser
+
+from articula.errors import ArticulaError
+from articula.loops.online import OnlineController
+from articula.loops.tracking import PlanResult, trace_columns, tracking_metrics
+from articula.planning.config import PlannerSpec, TrajectorySpec, make_targets
+from articula.planning.target_path import TargetPath
+from articula.runs.records import build_record, write_run
+from articula.runs.registry import Result
+from articula.scene.config import build_scene, load_scene_spec
+from articula.validation import load_toml
+from articula.viewer import drawing
+from articula.viewer.run_data import PLAN, TRACK, visuals_of
+
+METHODS = ("baornn", "baornn-improved", "pinv", "dls", "qp")
+
+
+@dataclass
+class Recording:
+    """What happened, period by period: times [s], configurations [rad], end-effector and
+    target positions [m], clearance [m], obstacle poses (name -> [x, y, z, qw, qx, qy, qz])."""
+
+    t: list[float] = field(default_factory=list)
+    q: list[np.ndarray] = field(default_factory=list)
+    x: list[np.ndarray] = field(default_factory=list)
+    x_ref: list[np.ndarray] = field(default_factory=list)
+    clearance: list[float] = field(default_factory=list)
+    obstacles: dict[str, list[np.ndarray]] = field(default_factory=dict)
+
+
+class Live:
+    """The live page of one scene file in one viser server."""
+
+    def __init__(self, server: viser.ViserServer, scene_file: Path, method: str | None) -> None:
+        self.server = server
+        self.config = _plan_config(scene_file)
+        if method is not None:
+            self.config["planner"]["method"] = method
+        self.scene, self.q0 = build_scene(load_scene_spec(self.config), scene_file.parent)
+        self.targets: TargetPath = make_targets(TrajectorySpec(**self.config["trajectory"]),
+                                                scene_file.parent)  # fmt: skip
+        planner = self.config["planner"]
+        gui = server.gui
+        self.method = gui.add_dropdown(
+            "method", METHODS, initial_value=planner.get("method", "baornn")
+        )
+        self.lam = gui.add_number("Λ", float(planner.get("lambda_weight", 0.0)), min=0.0, step=1e-4)
+        self.d_min = gui.add_number(
+            "d_min [m]", float(planner.get("d_min", 0.0)), min=0.0, step=1e-3
+        )
+        self.follow = gui.add_checkbox("follow the trajectory", True)
+        self.readout = gui.add_markdown("")
+        for handle in (self.method, self.lam, self.d_min):
+            handle.on_update(lambda _: self.rebuild())
+        server.scene.add_grid("/grid", width=2.0, height=2.0, cell_size=0.1)
+        drawing.aim_camera(server)
+        self.frames, self.meshes = drawing.add_robot(
+            server, visuals_of(self.config["robot"], self.scene)
+        )
+        self.gizmos = {}
+        for obstacle in self.scene.obstacles:
+            wxyz, position = drawing.wxyz_position(obstacle.pose_at(0.0))
+            self.gizmos[obstacle.name] = server.scene.add_transform_controls(
+                f"/obstacles/{obstacle.name}", scale=0.2, wxyz=wxyz, position=position)  # fmt: skip
+        drawing.add_obstacle_parts(server, self.scene)
+        self.target = server.scene.add_transform_controls("/target", scale=0.15,
+                                                          disable_rotations=True)  # fmt: skip
+        server.scene.add_icosphere("/target/ball", radius=0.01, color=drawing.REFERENCE_COLOUR)
+        self.recording = Recording()
+        self.periods = 0
+        self.step_ms: list[float] = []
+        self.controller: OnlineController | None = None
+        self.q = self.q0.copy()
+        self.rebuild()
+
+    @property
+    def dt(self) -> float:
+        """The control period [s]."""
+        return float(self.config["planner"].get("dt", 0.01))
+
+    def spec(self) -> PlannerSpec:
+        """The planner of the scene file with the panel's method, Λ and d_min."""
+        panel = {"method": self.method.value, "lambda_weight": float(self.lam.value),
+                 "d_min": float(self.d_min.value)}  # fmt: skip
+        return PlannerSpec(**(self.config["planner"] | panel))
+
+    def rebuild(self) -> None:
+        """A new controller from the panel's settings, started from the arm where it is; on
+        a start it refuses (within the new d_min, say) the old one goes on."""
+        try:
+            spec = self.spec()
+            seed = int(spec.seed or 0)
+            controller = OnlineController.from_spec(self.scene, spec, seed, live_obstacles=True)
+            self._push_poses(controller)
+            controller.reset(self.q)
+        except ArticulaError as exc:
+            if self.controller is None:
+                raise  # the scene file's own settings do not start: nothing to show
+            self.readout.content = f"**not changed:** {exc}"
+            return
+        self.controller = controller
+        self.config["planner"] |= {"method": spec.method, "lambda_weight": spec.lambda_weight,
+                                   "d_min": spec.d_min}  # fmt: skip
+
+    def period(self) -> float:
+        """One control period: obstacles from their gizmos, one planner step, the page
+        updated; returns the planner's time [s]."""
+        controller = self.controller
+        assert controller is not None
+        t = self.periods * self.dt
+        if self.follow.value:
+            target = self.targets(t).position
+            self.target.position = target
+        else:
+            target = np.asarray(self.target.position, dtype=float)
+        poses = self._gizmo_poses()
+        start = time.perf_counter()
+        self.q = controller.step(target, poses)
+        elapsed = time.perf_counter() - start
+        self.periods += 1
+        self.step_ms.append(1e3 * elapsed)
+        self._show(t, target, poses, elapsed)
+        return elapsed
+
+    def _show(
+        self, t: float, target: np.ndarray, poses: dict[str, np.ndarray], elapsed: float
+    ) -> None:
+        """Move the arm, colour it, write the readout and record the period."""
+        scene = self.controller.planner.scene  # its obstacles are the live ones
+        for name, T in scene.robot.link_poses(self.q).items():
+            if name in self.frames:
+                self.frames[name].wxyz, self.frames[name].position = drawing.wxyz_position(T)
+        d = (
+            scene.distances(self.q, t)
+            if scene.obstacles
+            else np.full((len(scene.robot.links), 1), np.inf)
+        )
+        for i, link in enumerate(scene.robot.links):
+            for mesh in self.meshes.get(link.name, ()):
+                mesh.color = drawing.clearance_colour(float(d[i].min()), float(self.d_min.value))
+        x = scene.robot.ee_position(self.q)
+        clearance = float(d.min())
+        late = elapsed > self.dt
+        error = float(np.linalg.norm(x - target))
+        self.readout.content = (
+            f"clearance **{1e3 * clearance:.1f} mm** · error {1e3 * error:.2f} mm"
+            f" · planner {1e3 * elapsed:.2f} ms per {1e3 * self.dt:.0f} ms period"
+            + (" · **over the period**" if late else "")
+        )
+        r = self.recording
+        r.t.append(t)
+        r.q.append(self.q.copy())
+        r.x.append(x)
+        r.x_ref.append(np.asarray(target, dtype=float).copy())
+        r.clearance.append(clearance)
+        for name, T in poses.items():
+            wxyz, position = drawing.wxyz_position(T)
+            r.obstacles.setdefault(name, []).append(np.r_[position, wxyz])
+
+    def _gizmo_poses(self) -> dict[str, np.ndarray]:
+        """Every obstacle's pose (4×4, world) from its gizmo."""
+        return {name: drawing.pose_of(g.wxyz, g.position) for name, g in self.gizmos.items()}
+
+    def _push_poses(self, controller: OnlineController) -> None:
+        """Give a new controller the obstacles where the gizmos hold them now."""
+        for name, T in self._gizmo_poses().items():
+            controller.live[name].pose = T
+
+    def write(self, folder: Path, wall_time: float) -> dict[str, Any]:
+        """The recording as a run folder `articula view` replays; returns its record."""
+        r = self.recording
+        if not r.t:
+            raise ArticulaError("--record: nothing happened yet (no control period ran)")
+        x, x_ref = np.array(r.x), np.array(r.x_ref)
+        run = PlanResult(np.array(r.t), np.array(r.q), x, x_ref, np.linalg.norm(x - x_ref, axis=1),
+                         np.array(r.clearance), 1e-3 * float(np.sum(self.step_ms[1:])),
+                         1e-3 * self.step_ms[0], self.q0)  # fmt: skip
+        iterations = float(self.controller.planner.iterations) if self.controller else 0.0
+        metrics = tracking_metrics(run, self.scene.robot, 0.0, iterations)
+        metrics["overrun_fraction"] = float(np.mean(np.array(self.step_ms) > 1e3 * self.dt))
+        trace = trace_columns(run)
+        for name, rows in r.obstacles.items():
+            for c, column in zip(TRACK, np.array(rows).T, strict=True):
+                trace[f"obstacle_{name}_{c}"] = column
+        config = {**self.config, "experiment": PLAN}
+        record = build_record(config, Result(metrics, {}), wall_time)
+        write_run(folder, config, record, trace)
+        return record
+
+
+def _plan_config(scene_file: Path) -> dict[str, Any]:
+    """A scene file as a plan config, its file paths absolute (so a recorded run finds them)."""
+    data = load_toml(scene_file)
+    if "trajectory" not in data:
+        raise ArticulaError(f"{scene_file}: live needs a [trajectory] table (the path to follow)")
+    base = scene_file.resolve().parent
+    for obstacle in data.get("obstacles", []):
+        if isinstance(obstacle, dict) and "mesh" in obstacle:
+            obstacle["mesh"] = str((base / obstacle["mesh"]).resolve())
+    robot = data.get("robot", {})
+    if "urdf" in robot:
+        robot["urdf"] = str((base / robot["urdf"]).resolve())
+    if "package_dirs" in robot:
+        robot["package_dirs"] = [str((base / d).resolve()) for d in robot["package_dirs"]]
+    trajectory = data["trajectory"]
+    if "path" in trajectory:
+        trajectory["path"] = str((base / trajectory["path"]).resolve())
+    data.setdefault("planner", {})
+    return data
+
+
+def run_live(scene_file: Path, method: str | None, host: str, port: int, record: Path | None,
+             announce) -> None:  # fmt: skip
+    """Serve the live page until Ctrl-C, a period every dt; then write --record if asked."""
+    from articula.viewer.replay import open_server
+
+    server = open_server(host, port)
+    started = time.monotonic()
+    live = None
+    try:
+        live = Live(server, scene_file, method)
+        announce(f"http://{host}:{port}")
+        next_period = time.perf_counter()
+        while True:
+            live.period()
+            next_period += live.dt
+            pause = next_period - time.perf_counter()
+            if pause > 0:
+                time.sleep(pause)
+            else:
+                next_period = time.perf_counter()  # late: start the next period now
+    except KeyboardInterrupt:
+        pass
+    finally:
+        server.stop()
+    if record is not None and live is not None:
+        live.write(record, time.monotonic() - started)

@@ -1,0 +1,94 @@
+"""`articula live`: an obstacle moved into the arm's way (through viser's server API, as a
+drag does) changes the clearance the planner reports, which stays above d_min; the panel
+rebuilds the controller; --record writes a run folder `view` replays with the moved obstacle;
+the page renders in Chromium."""
+
+from __future__ import annotations
+
+import signal
+
+import numpy as np
+import pytest
+import tomli_w
+import viser
+
+from articula.scene import Obstacle, Scene
+from articula.validation import load_toml
+from articula.viewer.drawing import pose_of
+from articula.viewer.live import Live
+from articula.viewer.run_data import load_run
+from tests.viewer.conftest import CONFIGS, free_port, open_page, robot_mask, screenshot
+
+
+@pytest.fixture
+def scene_file(tmp_path):
+    """The book's circle beside the rock, its mesh by absolute path."""
+    config = load_toml(CONFIGS / "circle_one_obstacle.toml")
+    for obstacle in config["obstacles"]:
+        obstacle["mesh"] = str(CONFIGS / obstacle["mesh"])
+    path = tmp_path / "scene.toml"
+    path.write_text(tomli_w.dumps(config))
+    return path
+
+
+@pytest.fixture
+def server():
+    """A viser server on a free port, stopped after the test."""
+    s = viser.ViserServer(host="127.0.0.1", port=free_port(), verbose=False)
+    yield s
+    s.stop()
+
+
+@pytest.mark.parametrize("method", ["qp", "baornn-improved"])
+def test_an_obstacle_pushed_into_the_arm_is_avoided(server, scene_file, tmp_path, method):
+    live = Live(server, scene_file, method)
+    d_min = live.controller.planner.d_min
+    for _ in range(100):  # 1 s along the circle
+        live.period()
+    before = live.recording.clearance[-1]
+    # The rock dropped 4 cm ahead of the elbow, where the elbow is heading.
+    robot, rock = live.scene.robot, live.gizmos["rock"]
+    elbow = [robot.link_poses(q)["iiwa_link_4"][:3, 3] for q in live.recording.q[-2:]]
+    heading = (elbow[1] - elbow[0]) / np.linalg.norm(elbow[1] - elbow[0])
+    parts = live.scene.obstacles[0].parts
+    for gap in np.arange(0.0, 0.5, 0.0025):
+        T = pose_of(rock.wxyz, elbow[1] + gap * heading)
+        if Scene(robot, [Obstacle("rock", parts, T)]).min_distance(live.q) >= 0.04:
+            break
+    rock.position = T[:3, 3]
+    for _ in range(200):
+        live.period()
+    after = live.recording.clearance[100:]
+    assert before - min(after) > 0.05  # the reported clearance follows the rock
+    assert min(after) > d_min  # and the planner keeps out of its way
+    assert "clearance" in live.readout.content
+    record = live.write(tmp_path / "rec", 1.0)
+    assert record["metrics"]["collisions"] == 0
+    replay = load_run(tmp_path / "rec")
+    assert np.allclose(replay.obstacle_poses(len(replay.t) - 1)["rock"][:3, 3], rock.position,
+                       atol=1e-6)  # fmt: skip
+    assert replay.closest(len(replay.t) - 1).distance == pytest.approx(after[-1], abs=1e-6)
+
+
+def test_the_panel_rebuilds_the_controller_and_refuses_a_start_within_d_min(server, scene_file):
+    live = Live(server, scene_file, "qp")
+    for _ in range(5):
+        live.period()
+    live.method.value = "baornn-improved"
+    live.rebuild()
+    assert type(live.controller.planner).__name__ == "ImprovedBaornn"
+    live.period()
+    old = live.controller
+    live.d_min.value = 5.0  # farther than any obstacle is
+    live.rebuild()
+    assert live.controller is old and "not changed" in live.readout.content
+
+
+def test_the_live_page_renders_and_ctrl_c_writes_the_record(scene_file, viewer, browser, tmp_path):
+    proc, url = viewer("live", scene_file, "--method", "qp", "--record", tmp_path / "rec")
+    page = open_page(browser, url, wait_for="clearance")
+    assert robot_mask(screenshot(page)[:, :900]).sum() > 2000
+    proc.send_signal(signal.SIGINT)
+    assert proc.wait(30) == 0
+    run = load_run(tmp_path / "rec")
+    assert len(run.t) > 10 and run.clearance.min() > 0
