@@ -4,6 +4,7 @@ colour of a link by its clearance."""
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 import trimesh
 import viser
 from scipy.spatial.transform import Rotation
@@ -28,8 +29,9 @@ def aim_camera(server: viser.ViserServer) -> None:
 
 
 def wxyz_position(T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """viser's (quaternion w, x, y, z; position) of a 4×4 pose."""
-    x, y, z, w = Rotation.from_matrix(T[:3, :3]).as_quat()
+    """viser's (quaternion w, x, y, z; position) of a 4×4 pose (Pinocchio's conversion: a
+    live page converts a dozen poses every 10 ms, scipy's takes ~0.2 ms each)."""
+    x, y, z, w = pin.Quaternion(np.ascontiguousarray(T[:3, :3])).coeffs()
     return np.array([w, x, y, z]), T[:3, 3].copy()
 
 

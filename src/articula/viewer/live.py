@@ -29,6 +29,9 @@ from articula.viewer import drawing
 from articula.viewer.run_data import PLAN, TRACK, visuals_of
 
 METHODS = ("baornn", "baornn-improved", "pinv", "dls", "qp")
+READOUT_EVERY = 10  # periods between readout updates (a person reads at most ~10 a second)
+DRAW_EVERY = 2  # periods between page updates: 50 Hz at 10 ms, smooth to the eye; the
+# control loop keeps its own rate (a page update costs ~2 ms of viser messages)
 
 
 @dataclass
@@ -83,6 +86,7 @@ class Live:
                                                           disable_rotations=True)  # fmt: skip
         server.scene.add_icosphere("/target/ball", radius=0.01, color=drawing.REFERENCE_COLOUR)
         self.recording = Recording()
+        self.colours: dict[str, tuple[int, int, int]] = {}
         self.periods = 0
         self.step_ms: list[float] = []
         self.controller: OnlineController | None = None
@@ -141,28 +145,19 @@ class Live:
     def _show(
         self, t: float, target: np.ndarray, poses: dict[str, np.ndarray], elapsed: float
     ) -> None:
-        """Move the arm, colour it, write the readout and record the period."""
+        """Record the period, and update the page every DRAW_EVERY periods (at once when the
+        planner ran over)."""
         scene = self.controller.planner.scene  # its obstacles are the live ones
-        for name, T in scene.robot.link_poses(self.q).items():
-            if name in self.frames:
-                self.frames[name].wxyz, self.frames[name].position = drawing.wxyz_position(T)
         d = (
             scene.distances(self.q, t)
             if scene.obstacles
             else np.full((len(scene.robot.links), 1), np.inf)
         )
-        for i, link in enumerate(scene.robot.links):
-            for mesh in self.meshes.get(link.name, ()):
-                mesh.color = drawing.clearance_colour(float(d[i].min()), float(self.d_min.value))
         x = scene.robot.ee_position(self.q)
         clearance = float(d.min())
         late = elapsed > self.dt
-        error = float(np.linalg.norm(x - target))
-        self.readout.content = (
-            f"clearance **{1e3 * clearance:.1f} mm** · error {1e3 * error:.2f} mm"
-            f" · planner {1e3 * elapsed:.2f} ms per {1e3 * self.dt:.0f} ms period"
-            + (" · **over the period**" if late else "")
-        )
+        if late or self.periods % DRAW_EVERY == 0:
+            self._draw(d, x, target, clearance, elapsed)
         r = self.recording
         r.t.append(t)
         r.q.append(self.q.copy())
@@ -172,6 +167,31 @@ class Live:
         for name, T in poses.items():
             wxyz, position = drawing.wxyz_position(T)
             r.obstacles.setdefault(name, []).append(np.r_[position, wxyz])
+
+    def _draw(
+        self, d: np.ndarray, x: np.ndarray, target: np.ndarray, clearance: float, elapsed: float
+    ) -> None:
+        """Move the arm, colour its links by clearance (d: links × obstacles [m]) and write the
+        readout (every READOUT_EVERY periods, or when over the period): one batch of messages."""
+        scene = self.controller.planner.scene
+        late = elapsed > self.dt
+        with self.server.atomic():
+            for name, T in scene.robot.link_poses(self.q).items():
+                if name in self.frames:
+                    self.frames[name].wxyz, self.frames[name].position = drawing.wxyz_position(T)
+            for i, link in enumerate(scene.robot.links):
+                colour = drawing.clearance_colour(float(d[i].min()), float(self.d_min.value))
+                if self.colours.get(link.name) != colour:  # only what changed goes out
+                    self.colours[link.name] = colour
+                    for mesh in self.meshes.get(link.name, ()):
+                        mesh.color = colour
+            if late or self.periods % READOUT_EVERY == 0:
+                error = float(np.linalg.norm(x - target))
+                self.readout.content = (
+                    f"clearance **{1e3 * clearance:.1f} mm** · error {1e3 * error:.2f} mm"
+                    f" · planner {1e3 * elapsed:.2f} ms per {1e3 * self.dt:.0f} ms period"
+                    + (" · **over the period**" if late else "")
+                )
 
     def _gizmo_poses(self) -> dict[str, np.ndarray]:
         """Every obstacle's pose (4×4, world) from its gizmo."""
