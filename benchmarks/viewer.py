@@ -8,7 +8,7 @@ tab connected when Debian's Chromium and Playwright are here (headless, software
 or with --no-browser, none, and `browser_connected` says so), paced at the scene's 10 ms
 period like `articula live`:
   live_period_ms          median wall time [ms] of one period: gizmo poses read, planner step,
-                          clearance recorded, and every DRAW_EVERY-th period (50 Hz) the arm,
+                          clearance recorded, and every DRAW_EVERY-th period (33 Hz) the arm,
                           colours and readout pushed to the page (the worse method's)
   live_overrun_fraction   fraction of periods longer than dt (the worse method's)
   <method>_period_ms, <method>_overrun_fraction, <method>_planner_ms (the step alone)

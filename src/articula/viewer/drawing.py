@@ -7,7 +7,6 @@ import numpy as np
 import pinocchio as pin
 import trimesh
 import viser
-from scipy.spatial.transform import Rotation
 
 from articula.robots.urdf_visuals import Visual
 from articula.scene.scene import Scene
@@ -93,7 +92,7 @@ def pose_of(wxyz: np.ndarray, position: np.ndarray) -> np.ndarray:
     """The 4×4 pose of viser's (quaternion w, x, y, z; position)."""
     w, x, y, z = np.asarray(wxyz, dtype=float)
     T = np.eye(4)
-    T[:3, :3] = Rotation.from_quat([x, y, z, w]).as_matrix()
+    T[:3, :3] = pin.Quaternion(w, x, y, z).normalized().toRotationMatrix()
     T[:3, 3] = position
     return T
 

@@ -30,7 +30,7 @@ from articula.viewer.run_data import PLAN, TRACK, visuals_of
 
 METHODS = ("baornn", "baornn-improved", "pinv", "dls", "qp")
 READOUT_EVERY = 10  # periods between readout updates (a person reads at most ~10 a second)
-DRAW_EVERY = 2  # periods between page updates: 50 Hz at 10 ms, smooth to the eye; the
+DRAW_EVERY = 3  # periods between page updates: 33 Hz at 10 ms, smooth to the eye; the
 # control loop keeps its own rate (a page update costs ~2 ms of viser messages)
 
 
@@ -130,7 +130,6 @@ class Live:
         t = self.periods * self.dt
         if self.follow.value:
             target = self.targets(t).position
-            self.target.position = target
         else:
             target = np.asarray(self.target.position, dtype=float)
         poses = self._gizmo_poses()
@@ -148,16 +147,15 @@ class Live:
         """Record the period, and update the page every DRAW_EVERY periods (at once when the
         planner ran over)."""
         scene = self.controller.planner.scene  # its obstacles are the live ones
-        d = (
-            scene.distances(self.q, t)
-            if scene.obstacles
-            else np.full((len(scene.robot.links), 1), np.inf)
-        )
         x = scene.robot.ee_position(self.q)
-        clearance = float(d.min())
         late = elapsed > self.dt
         if late or self.periods % DRAW_EVERY == 0:
+            d = (scene.distances(self.q, t) if scene.obstacles
+                 else np.full((len(scene.robot.links), 1), np.inf))  # fmt: skip
+            clearance = float(d.min())
             self._draw(d, x, target, clearance, elapsed)
+        else:
+            clearance = scene.min_distance(self.q, t) if scene.obstacles else np.inf
         r = self.recording
         r.t.append(t)
         r.q.append(self.q.copy())
@@ -176,6 +174,8 @@ class Live:
         scene = self.controller.planner.scene
         late = elapsed > self.dt
         with self.server.atomic():
+            if self.follow.value:
+                self.target.position = target
             for name, T in scene.robot.link_poses(self.q).items():
                 if name in self.frames:
                     self.frames[name].wxyz, self.frames[name].position = drawing.wxyz_position(T)
