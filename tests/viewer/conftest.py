@@ -118,10 +118,13 @@ def screenshot(page) -> np.ndarray:
 
 
 def robot_mask(image: np.ndarray) -> np.ndarray:
-    """Pixels of the robot's orange (any shade the lights give it): red high, green between,
-    blue low."""
-    r, g, b = image[..., 0], image[..., 1], image[..., 2]
-    return (r > 120) & (g > 0.35 * r) & (g < 0.8 * r) & (b < 0.35 * r)
+    """Pixels of the robot in the 3-D view (left of the panel, right of the software-WebGL
+    notice's orange bar): its orange, shaded toward red near obstacles, in any light: red
+    high, green below it, blue low (the grey obstacles, green and blue paths and white
+    background are not)."""
+    view = image[:, 40:900]
+    r, g, b = view[..., 0], view[..., 1], view[..., 2]
+    return (r > 120) & (g < 0.8 * r) & (b < 0.35 * r)
 
 
 os.environ.setdefault("PLAYWRIGHT_SKIP_BROWSER_DOWNLOAD", "1")
