@@ -88,6 +88,7 @@ def robot_table(robot: str) -> dict[str, Any]:
     """The [robot] table of --robot: a built-in name, a URDF file or a TOML file's [robot]
     table, paths made absolute."""
     from articula.errors import ConfigError
+    from articula.planning.config import absolute_paths
     from articula.validation import load_toml
 
     path = Path(robot)
@@ -99,13 +100,7 @@ def robot_table(robot: str) -> dict[str, Any]:
         data = load_toml(path)
         if not isinstance(data.get("robot"), dict):
             raise ConfigError("--robot", f"{path} has no [robot] table")
-        table = dict(data["robot"])
-        base = path.resolve().parent
-        if "urdf" in table:
-            table["urdf"] = str((base / table["urdf"]).resolve())
-        if "package_dirs" in table:
-            table["package_dirs"] = [str((base / d).resolve()) for d in table["package_dirs"]]
-        return table
+        return absolute_paths({"robot": data["robot"]}, path.resolve().parent)["robot"]
     return {"builtin": robot}
 
 

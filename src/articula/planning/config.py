@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -27,7 +27,7 @@ from articula.planning.task import Task, TaskKind
 from articula.planning.trajectories import Circle, Waypoints, rectangle
 from articula.planning.velocity_ik import VelocityIk, VelocityIkParams
 from articula.robots.model import RobotModel
-from articula.scene.config import resolve_path
+from articula.scene.config import PACKAGE_URI, resolve_path
 from articula.scene.scene import Scene
 from articula.validation import (
     Finite,
@@ -240,3 +240,31 @@ def _trajectory(spec: TrajectorySpec, base_dir: Path) -> Circle | Waypoints:
     if spec.type == "waypoints":
         return Waypoints.create(spec.points or [], spec.times or [])
     return Waypoints.from_csv(resolve_path(base_dir, spec.path or ""))
+
+
+def absolute_paths(data: dict[str, Any], base_dir: Path) -> dict[str, Any]:
+    """The config with its URDF, package folders, obstacle meshes and trajectory CSV made
+    absolute from `base_dir`, so that a run folder's config.toml still finds them."""
+
+    def absolute(path: Any) -> Any:
+        if not isinstance(path, str) or path.startswith(PACKAGE_URI):
+            return path  # a package path is the same on every machine
+        return str(resolve_path(base_dir, path).resolve())
+
+    out = dict(data)
+    if isinstance(data.get("robot"), dict):
+        robot = dict(data["robot"])
+        if "urdf" in robot:
+            robot["urdf"] = absolute(robot["urdf"])
+        if isinstance(robot.get("package_dirs"), list):
+            robot["package_dirs"] = [absolute(d) for d in robot["package_dirs"]]
+        out["robot"] = robot
+    if isinstance(data.get("obstacles"), list):
+        out["obstacles"] = [
+            {**o, "mesh": absolute(o["mesh"])} if isinstance(o, dict) and "mesh" in o else o
+            for o in data["obstacles"]
+        ]
+    trajectory = data.get("trajectory")
+    if isinstance(trajectory, dict) and "path" in trajectory:
+        out["trajectory"] = {**trajectory, "path": absolute(trajectory["path"])}
+    return out

@@ -27,7 +27,7 @@ from articula.numba_cache import jit
 from articula.scene.compiled_poses import (
     _apply,
     _capsule_gaps,
-    _compose,
+    _ee_pose,
     _joint_poses,
     _remember,
     _remembered_bound,
@@ -323,10 +323,7 @@ def _evaluate(
     each shape has moved since (`memory`; a search evaluates nearby configurations, so this
     is the tighter one: a far pair is measured once, not at every evaluation)."""
     oR, op = _joint_poses(q, parents, joint_rot, joint_p, axes, q_index)
-    ee = np.empty(3)
-    _apply(oR[ee_joint], op[ee_joint], ee_p, ee)
-    ee_R = np.empty((3, 3))
-    _compose(oR[ee_joint], op[ee_joint], ee_rot, ee_p, ee_R, np.empty(3))
+    ee, ee_R = _ee_pose(oR, op, ee_joint, ee_p, ee_rot)
     world_R, world_p, ends = _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a,
                                           capsule_b, pairs)  # fmt: skip
     npairs = pairs.shape[0]

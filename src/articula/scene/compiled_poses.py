@@ -94,6 +94,17 @@ def _joint_poses(q, parents, joint_rot, joint_p, axes, q_index):  # fmt: skip
 
 
 @jit()
+def _ee_pose(oR, op, ee_joint, ee_p, ee_rot):  # fmt: skip
+    """The end effector's world position and rotation from its joint's pose and its
+    placement (ee_rot, ee_p) in that joint's frame."""
+    ee = np.empty(3)
+    _apply(oR[ee_joint], op[ee_joint], ee_p, ee)
+    ee_R = np.empty((3, 3))
+    _compose(oR[ee_joint], op[ee_joint], ee_rot, ee_p, ee_R, np.empty(3))
+    return ee, ee_R
+
+
+@jit()
 def _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a, capsule_b, pairs):  # fmt: skip
     """World pose of every shape of `pairs` and the ends of its bounding capsule's segment
     (the other shapes' rows are left unset: a far obstacle costs nothing here)."""

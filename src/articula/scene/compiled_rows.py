@@ -18,9 +18,8 @@ import numpy as np
 from articula.numba_cache import jit
 from articula.scene.compiled_clearance import CompiledClearance
 from articula.scene.compiled_poses import (
-    _apply,
     _capsule_gaps,
-    _compose,
+    _ee_pose,
     _joint_poses,
     _shape_poses,
 )
@@ -91,10 +90,7 @@ def _rows(
 ):  # fmt: skip
     """clearance_rows in one compiled call; the last item flags an overlap."""
     oR, op = _joint_poses(q, parents, joint_rot, joint_p, axes, q_index)
-    ee = np.empty(3)
-    _apply(oR[ee_joint], op[ee_joint], ee_p, ee)
-    ee_R = np.empty((3, 3))
-    _compose(oR[ee_joint], op[ee_joint], ee_rot, ee_p, ee_R, np.empty(3))
+    ee, ee_R = _ee_pose(oR, op, ee_joint, ee_p, ee_rot)
     J = _jacobian(oR, op, axes, parents, q_index, ee_joint, ee, nq)
     world_R, world_p, ends = _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a,
                                           capsule_b, pairs)  # fmt: skip

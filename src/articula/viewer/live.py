@@ -19,7 +19,7 @@ import viser
 from articula.errors import ArticulaError
 from articula.loops.online import OnlineController
 from articula.loops.tracking import PlanResult, trace_columns, tracking_metrics
-from articula.planning.config import PlannerSpec, TrajectorySpec, make_targets
+from articula.planning.config import PlannerSpec, TrajectorySpec, absolute_paths, make_targets
 from articula.planning.target_path import TargetPath
 from articula.runs.records import build_record, write_run
 from articula.runs.registry import Result
@@ -229,20 +229,8 @@ def _plan_config(scene_file: Path) -> dict[str, Any]:
     data = load_toml(scene_file)
     if "trajectory" not in data:
         raise ArticulaError(f"{scene_file}: live needs a [trajectory] table (the path to follow)")
-    base = scene_file.resolve().parent
-    for obstacle in data.get("obstacles", []):
-        if isinstance(obstacle, dict) and "mesh" in obstacle:
-            obstacle["mesh"] = str((base / obstacle["mesh"]).resolve())
-    robot = data.get("robot", {})
-    if "urdf" in robot:
-        robot["urdf"] = str((base / robot["urdf"]).resolve())
-    if "package_dirs" in robot:
-        robot["package_dirs"] = [str((base / d).resolve()) for d in robot["package_dirs"]]
-    trajectory = data["trajectory"]
-    if "path" in trajectory:
-        trajectory["path"] = str((base / trajectory["path"]).resolve())
     data.setdefault("planner", {})
-    return data
+    return absolute_paths(data, scene_file.resolve().parent)
 
 
 def run_live(scene_file: Path, method: str | None, host: str, port: int, record: Path | None,

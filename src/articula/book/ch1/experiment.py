@@ -15,10 +15,16 @@ from pydantic import model_validator
 
 from articula.errors import ConfigError, InfeasibleError
 from articula.loops.tracking import trace_columns, track, tracking_metrics
-from articula.planning.config import PlannerSpec, TrajectorySpec, make_planner, make_targets
+from articula.planning.config import (
+    PlannerSpec,
+    TrajectorySpec,
+    absolute_paths,
+    make_planner,
+    make_targets,
+)
 from articula.planning.reach import check_reach
 from articula.runs.registry import Experiment, Progress, Result
-from articula.scene.config import PACKAGE_URI, SceneSpec, build_scene, resolve_path
+from articula.scene.config import SceneSpec, build_scene
 from articula.validation import Seed, fields_as, load_toml
 
 NAME = "baornn.plan"
@@ -69,34 +75,6 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
             "trajectory",
         )
     return Result(metrics, trace_columns(run))
-
-
-def absolute_paths(data: dict[str, Any], base_dir: Path) -> dict[str, Any]:
-    """The config with its URDF, package folders, obstacle meshes and trajectory CSV made
-    absolute from `base_dir`, so that a run folder's config.toml still finds them."""
-
-    def absolute(path: Any) -> Any:
-        if not isinstance(path, str) or path.startswith(PACKAGE_URI):
-            return path  # a package path is the same on every machine
-        return str(resolve_path(base_dir, path).resolve())
-
-    out = dict(data)
-    if isinstance(data.get("robot"), dict):
-        robot = dict(data["robot"])
-        if "urdf" in robot:
-            robot["urdf"] = absolute(robot["urdf"])
-        if isinstance(robot.get("package_dirs"), list):
-            robot["package_dirs"] = [absolute(d) for d in robot["package_dirs"]]
-        out["robot"] = robot
-    if isinstance(data.get("obstacles"), list):
-        out["obstacles"] = [
-            {**o, "mesh": absolute(o["mesh"])} if isinstance(o, dict) and "mesh" in o else o
-            for o in data["obstacles"]
-        ]
-    trajectory = data.get("trajectory")
-    if isinstance(trajectory, dict) and "path" in trajectory:
-        out["trajectory"] = {**trajectory, "path": absolute(trajectory["path"])}
-    return out
 
 
 def load_plan(path: Path) -> dict[str, Any]:
