@@ -54,8 +54,19 @@ def test_warm_start_does_not_change_the_answer():
     Q = rng.uniform(ROBOT.lower, ROBOT.upper, (100, ROBOT.nq))
     warm = CompiledClearance.build(scene)
     first = [warm.evaluate(q)[0] for q in Q]
-    again = [warm.evaluate(q)[0] for q in Q[::-1]][::-1]  # other hints and guesses
+    again = [warm.evaluate(q)[0] for q in Q[::-1]][::-1]  # other hints and simplices
     assert np.allclose(first, again, atol=1e-9, rtol=0)
+
+
+def test_small_steps_reuse_memory_and_simplices_without_changing_the_answer():
+    # A search's evaluations are close together: the remembered bounds and the cached GJK
+    # simplices do the work there, so check them along a smooth path through near-contacts.
+    scene = book_scene("circle_two_obstacles")
+    compiled = CompiledClearance.build(scene)
+    start, end = np.zeros(ROBOT.nq), np.array([0.9, 0.8, 0.5, -1.2, 0.4, 0.9, 0.2])
+    for s in np.linspace(0.0, 1.0, 300):
+        q = start + s * (end - start) + 0.002 * np.sin(40 * s + np.arange(ROBOT.nq))
+        assert compiled.evaluate(q)[0] == pytest.approx(max(scene.min_distance(q), 0.0), abs=1e-6)
 
 
 def test_cylinders_have_no_compiled_form():
@@ -71,7 +82,7 @@ def test_a_moving_obstacle_is_where_its_pose_puts_it_at_each_time():
     scene = Scene(ROBOT, [moving, still])
     compiled = CompiledClearance.build(scene)
     q = np.array([0.3, 0.5, 0.0, -1.0, 0.0, 0.6, 0.0])
-    for t in (0.0, 1.0, 2.5, 4.0, 1.0):
+    for t in (0.0, 1.0, 2.5, 4.0, 1.0, *np.linspace(1.0, 1.2, 20)):
         compiled.at(t)
         assert compiled.evaluate(q)[0] == pytest.approx(scene.min_distance(q, t), abs=1e-7)
 

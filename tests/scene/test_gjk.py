@@ -28,7 +28,7 @@ def cube_distance():
     def distance(offset, r1: float = 0.0, r2: float = 0.0) -> float:
         args = (c.vertices, c.neighbours, c.offsets, c.hints.copy())
         return gjk_distance(*args, k, eye, np.zeros(3), r1, k, eye, np.asarray(offset, float),
-                            r2, np.zeros(3))  # fmt: skip
+                            r2, np.zeros(7, dtype=np.int64))  # fmt: skip
 
     return distance
 
@@ -49,3 +49,26 @@ def test_sweeping_radii_are_subtracted(cube_distance):
 
 def test_overlapping_cubes_are_at_distance_zero(cube_distance):
     assert cube_distance([0.9, 0.1, 0.0]) == 0.0
+
+
+def test_a_cached_simplex_gives_the_cold_answer_along_a_path_through_contact():
+    # Two cubes, one turning and sliding past the other through face, edge and corner
+    # contacts and an overlap: GJK restarted from the last simplex (the planner's case)
+    # answers as a cold start does; the cache holds edges and triangles on the way, 0 on overlap.
+    corners = np.array(np.meshgrid([-0.5, 0.5], [-0.5, 0.5], [-0.5, 0.5])).reshape(3, -1).T
+    c = CompiledClearance.build(Scene(ROBOT, [Obstacle("a", (convex_hull(corners),), np.eye(4))]))
+    k = len(ROBOT.links)
+    cache = np.zeros(7, dtype=np.int64)
+    sizes = set()
+    for s in np.linspace(0.0, 1.0, 200):
+        angle = 1.5 * s
+        R = np.array([[np.cos(angle), -np.sin(angle), 0.0], [np.sin(angle), np.cos(angle), 0.0],
+                      [0.0, 0.0, 1.0]])  # fmt: skip
+        p = np.array([1.6 - 0.8 * s, 0.9 * s, 0.3 * np.sin(5 * s)])
+        args = (c.vertices, c.neighbours, c.offsets, c.hints, k, np.eye(3), np.zeros(3), 0.0,
+                k, R, p, 0.05)  # fmt: skip
+        warm = gjk_distance(*args, cache)
+        cold = gjk_distance(*args, np.zeros(7, dtype=np.int64))
+        assert warm == pytest.approx(cold, abs=1e-12)
+        sizes.add(int(cache[0]))
+    assert sizes >= {0, 2, 3}

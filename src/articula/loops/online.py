@@ -147,7 +147,7 @@ class OnlineController:
             else:
                 target = Target(arr)
         position = np.asarray(target.position, dtype=float)
-        if position.shape != (3,) or not np.all(np.isfinite(position)):
+        if position.shape != (3,) or not np.isfinite(position).all():
             raise ConfigError(
                 "target", f"needs 3 finite coordinates [m] or a 4×4 pose (got {position.tolist()})"
             )

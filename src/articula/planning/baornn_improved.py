@@ -53,11 +53,11 @@ class ImprovedBaornn(BeetleSearch):
         if obj.compiled is not None:
             return self._compiled(q, g, np.zeros(0), target, draw[None], t)
         lam = p.c1 * math.sqrt(obj.tracking_error(q, target))
-        # Orthonormal directions: QR of a Gaussian matrix (columns), as many as pairs.
-        directions, _ = np.linalg.qr(draw)
+        # Orthonormal directions from a Gaussian matrix (columns), as many as pairs.
+        directions = kernel._orthonormal_columns(draw)
         gradient = np.zeros(q.size)
         best_q, best_g = q, g
-        for j, b in enumerate(directions.T):
+        for j, b in enumerate(directions):
             scale = kernel.antenna_scale(j, p.short_antenna)
             length = scale * lam
             # Eq. (1.15): the two antennae.
@@ -70,7 +70,7 @@ class ImprovedBaornn(BeetleSearch):
                 if g_a < best_g:
                     best_q, best_g = q_a, g_a
         norm = math.sqrt(gradient @ gradient)
-        self.evaluations += 2 * directions.shape[1]
+        self.evaluations += 2 * directions.shape[0]
         if norm > 0:
             step = q - p.c2 * lam * gradient / norm  # Eq. (1.19) along the estimated gradient
             q_new, g_new = obj.project_and_value(step, q, g, target, t, self._box)

@@ -86,6 +86,18 @@ def antenna_scale(pair: int, short: float) -> float:
 
 
 @jit()
+def _orthonormal_columns(draw):  # fmt: skip
+    """The columns of `draw` (n × m, m ≤ n) made orthonormal by Gram-Schmidt, as rows: the Q
+    of its QR up to the signs of its columns (which only swap an antenna pair's ends)."""
+    out = np.ascontiguousarray(draw.T)
+    for j in range(out.shape[0]):
+        for i in range(j):
+            out[j] -= (out[i] @ out[j]) * out[i]
+        out[j] /= math.sqrt(out[j] @ out[j])
+    return out
+
+
+@jit()
 def improved_period(
     q, g_known, warm_motion, x_ref, orient, draws, c1, c2, short, lambda_weight, beta, d_min, lower,
     upper, arrays, static_min,
@@ -93,8 +105,8 @@ def improved_period(
     """One control period of baornn-improved (planning/baornn_improved.py): g at q for the
     new reference (g_known instead when it is not NaN: a caller's g(q)), the warm start
     q + warm_motion (none when it is empty), then one iteration per draws[k], an
-    (n × pairs) Gaussian matrix whose QR gives the antenna directions; returns the accepted
-    (q, g) and the number of objective evaluations."""
+    (n × pairs) Gaussian matrix whose orthonormalised columns are the antenna directions;
+    returns the accepted (q, g) and the number of objective evaluations."""
     d, _, ee, ee_R = _evaluate(q, *arrays, static_min)
     e = _task_error(ee, ee_R, x_ref, orient)
     g = _penalised(e, d, lambda_weight, beta) if math.isnan(g_known) else g_known
@@ -109,11 +121,11 @@ def improved_period(
     n = q.size
     for k in range(draws.shape[0]):
         lam = c1 * math.sqrt(e)  # c1·√e_k, e_k the task error at the accepted q
-        directions, _ = np.linalg.qr(draws[k])
+        directions = _orthonormal_columns(draws[k])
         gradient = np.zeros(n)
         best_q, best_g, best_e = q, g, e
-        for j in range(directions.shape[1]):
-            b = np.ascontiguousarray(directions[:, j])
+        for j in range(directions.shape[0]):
+            b = directions[j]
             scale = antenna_scale(j, short)
             q_left, g_left, e_left = _project_and_value(
                 q + scale * lam * b, q, g, e, x_ref, orient, lambda_weight, beta, d_min, lower,

@@ -15,7 +15,7 @@ come out apart.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import ClassVar
 
 import numpy as np
@@ -31,6 +31,7 @@ from articula.scene.compiled_poses import (
     _joint_poses,
     _remember,
     _remembered_bound,
+    _segment_distance,
     _shape_poses,
 )
 from articula.scene.gjk import gjk_distance
@@ -58,7 +59,7 @@ class CompiledClearance:
     neighbours: np.ndarray  # vertices joined by a hull edge, CSR by vertex (global indices)
     offsets: np.ndarray  # (total + 1,)
     hints: np.ndarray  # (shapes,) where each support search starts (mutable scratch)
-    guesses: np.ndarray  # (pairs, 3) last closest point of each pair's A − B (mutable scratch)
+    simplices: np.ndarray  # (pairs, 7) each pair's GJK warm start (gjk.py; mutable scratch)
     memory: np.ndarray  # (pairs, 25) last exact distance, then the two shapes' poses (R, p)
     # at that time (mutable scratch; distance −inf: none yet)
     extents: np.ndarray  # (shapes,) largest |x| of a core vertex in the shape's frame [m]
@@ -69,11 +70,12 @@ class CompiledClearance:
     capsule_a: np.ndarray  # (shapes, 3) ends of each bounding capsule, in the shape's frame
     capsule_b: np.ndarray
     capsule_r: np.ndarray
-    pairs: np.ndarray  # (pairs, 5) (shape, shape, guess row, OBSTACLE | SELF, cell) that move
+    pairs: np.ndarray  # (pairs, 5) (shape, shape, cache row, OBSTACLE | SELF, cell) that move
     cells: int  # (link, obstacle) cells, row-major, then the checked link pairs in scene order
     static_min: np.ndarray  # (2,) smallest distance of the pairs that never move, per kind
     reach: float  # [m] no shape point is farther than this from any joint origin, in any pose
     moving_parts: tuple[tuple[int, object], ...] = ()  # (shape, its obstacle) that move
+    _selected: dict = field(default_factory=dict, repr=False)  # select's answers, by kinds
 
     @classmethod
     def build(cls, scene: Scene) -> CompiledClearance | None:
@@ -140,7 +142,7 @@ class CompiledClearance:
             neighbours=neighbours,
             offsets=offsets,
             hints=starts[:-1].copy(),
-            guesses=np.zeros((len(pairs), 3)),
+            simplices=np.zeros((len(pairs), 7), dtype=np.int64),
             memory=np.full((len(pairs), 25), -np.inf),
             extents=np.array([np.max(np.linalg.norm(c[0], axis=1)) for c in cores]),
             radii=np.array([c[1] for c in cores], dtype=float),
@@ -163,11 +165,17 @@ class CompiledClearance:
         return out
 
     def at(self, t: float) -> None:
-        """Put the moving obstacles' shapes at their poses of time t [s] (in place)."""
+        """Put the moving obstacles' shapes at their poses of time t [s] (in place), and lower
+        the remembered bounds of their pairs by how far each moved."""
         for shape, obstacle in self.moving_parts:
             T = obstacle.pose_at(t)
-            self.shape_rot[shape] = T[:3, :3]
-            self.shape_p[shape] = T[:3, 3]
+            R0, p0 = self.shape_rot[shape], self.shape_p[shape]
+            turn = math.sqrt(max(3.0 - float(np.sum(R0 * T[:3, :3])), 0.0))
+            moved = float(np.linalg.norm(T[:3, 3] - p0)) + turn * self.extents[shape]
+            if moved > 0.0:
+                self.memory[self.pairs[self.pairs[:, 1] == shape, 2], 0] -= moved
+                self.shape_rot[shape] = T[:3, :3]
+                self.shape_p[shape] = T[:3, 3]
 
     no_pairs: ClassVar[np.ndarray] = np.zeros((0, 5), dtype=np.int64)  # kinematics only
 
@@ -181,9 +189,14 @@ class CompiledClearance:
         return _evaluate(q, *self.arrays(pairs), static_min)
 
     def select(self, obstacles: bool, self_pairs: bool) -> tuple[np.ndarray, np.ndarray]:
-        """(pairs, static_min) of the kinds asked for; the others count as +inf."""
-        keep = np.array([obstacles, self_pairs])
-        return self.pairs[keep[self.pairs[:, 3]]], np.where(keep, self.static_min, np.inf)
+        """(pairs, static_min) of the kinds asked for; the others count as +inf (read-only:
+        the same arrays every call)."""
+        kinds = (bool(obstacles), bool(self_pairs))
+        if kinds not in self._selected:
+            keep = np.array(kinds)
+            self._selected[kinds] = (self.pairs[keep[self.pairs[:, 3]]],
+                                     np.where(keep, self.static_min, np.inf))  # fmt: skip
+        return self._selected[kinds]
 
     def near_pairs(self, pairs: np.ndarray, box: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
         """The rows of `pairs` that can hold the smallest link-obstacle distance anywhere in
@@ -205,7 +218,7 @@ class CompiledClearance:
         pairs = self.pairs if pairs is None else pairs
         return (self.parents, self.joint_rot, self.joint_p, self.axes, self.q_index,
                 self.ee_joint, self.ee_p, self.ee_rot, self.vertices, self.starts, self.neighbours,
-                self.offsets, self.hints, self.guesses, self.memory, self.extents, self.radii,
+                self.offsets, self.hints, self.simplices, self.memory, self.extents, self.radii,
                 self.shape_joint, self.shape_rot, self.shape_p, self.capsule_a, self.capsule_b,
                 self.capsule_r, pairs)  # fmt: skip
 
@@ -224,7 +237,7 @@ def _reach(placements: list, poses: list[np.ndarray], cores: list) -> float:
 
 
 def _pair_rows(pairs: list[tuple[int, int, int, int]], index: dict) -> np.ndarray:
-    """(shape a, shape b, guess row, kind, cell) rows of `pairs`."""
+    """(shape a, shape b, cache row, kind, cell) rows of `pairs`."""
     rows = [(a, b, index[a, b, kind, cell], kind, cell) for a, b, kind, cell in pairs]
     return np.array(rows, dtype=np.int64).reshape(-1, 5)
 
@@ -312,49 +325,60 @@ def _near_pairs(
 @jit()
 def _evaluate(
     q, parents, joint_rot, joint_p, axes, q_index, ee_joint, ee_p, ee_rot, vertices, starts,
-    neighbours, offsets, hints, guesses, memory, extents, radii, shape_joint, shape_rot,
+    neighbours, offsets, hints, simplices, memory, extents, radii, shape_joint, shape_rot,
     shape_p, capsule_a, capsule_b, capsule_r, pairs, static_min,
 ):  # fmt: skip
     """(obstacle clearance, self clearance, end-effector position, end-effector rotation):
     forward kinematics, shape poses, lower bounds, then exact GJK in order of bound, skipping
     a pair whose bound is not below the best distance of its kind (the broad phase of Scene).
 
-    A pair's bound is the larger of its capsules' gap and its last exact distance less how far
-    each shape has moved since (`memory`; a search evaluates nearby configurations, so this
-    is the tighter one: a far pair is measured once, not at every evaluation)."""
+    A pair's bound is its last bound (`memory`: an exact distance, or a capsule gap that ruled
+    it out) less how far each shape has moved since: a search evaluates nearby
+    configurations, so a far pair is measured once, not at every evaluation. Its capsules'
+    gap is taken only when that is not enough, and remembered when it rules the pair out."""
     oR, op = _joint_poses(q, parents, joint_rot, joint_p, axes, q_index)
     ee, ee_R = _ee_pose(oR, op, ee_joint, ee_p, ee_rot)
     world_R, world_p, ends = _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a,
                                           capsule_b, pairs)  # fmt: skip
     npairs = pairs.shape[0]
-    lower = _capsule_gaps(ends, capsule_r, pairs)
-    for k in range(npairs):
-        lower[k] = max(lower[k], _remembered_bound(memory[pairs[k, 2]], pairs[k, 0], pairs[k, 1],
-                                                   world_R, world_p, extents))  # fmt: skip
+    lower = np.empty(npairs)
     has_obstacle = has_self = False  # a kind without pairs here cannot improve
     for k in range(npairs):
+        lower[k] = _remembered_bound(memory[pairs[k, 2]], pairs[k, 0], pairs[k, 1], world_R,
+                                     world_p, extents, shape_joint)  # fmt: skip
         if pairs[k, 3] == 1:
             has_self = True
         else:
             has_obstacle = True
     # Scalars, not a 2-array: this runs three times per BAORNN iteration.
     best_obstacle, best_self = static_min[0], static_min[1]
-    for k in np.argsort(lower):
+    for _ in range(npairs):
+        k = np.argmin(lower)  # in order of bound: few pairs are taken, a sort costs more
+        bound = lower[k]
+        lower[k] = np.inf
         limit = -np.inf
         if has_obstacle:
             limit = best_obstacle
         if has_self and best_self > limit:
             limit = best_self
-        if lower[k] >= limit:
+        if bound >= limit:
             break  # no later pair can lower either minimum
         self_pair = pairs[k, 3] == 1
-        if lower[k] >= (best_self if self_pair else best_obstacle):
+        best = best_self if self_pair else best_obstacle
+        if bound >= best:
             continue
         a, b = pairs[k, 0], pairs[k, 1]
+        row = memory[pairs[k, 2]]
+        gap = _segment_distance(ends[a, 0], ends[a, 1], ends[b, 0], ends[b, 1])
+        gap -= capsule_r[a] + capsule_r[b]
+        if gap >= best:
+            if gap > bound:
+                _remember(row, gap, world_R[a], world_p[a], world_R[b], world_p[b])
+            continue
         d = gjk_distance(vertices, neighbours, offsets, hints,
                          a, world_R[a], world_p[a], radii[a],
-                         b, world_R[b], world_p[b], radii[b], guesses[pairs[k, 2]])  # fmt: skip
-        _remember(memory[pairs[k, 2]], d, world_R[a], world_p[a], world_R[b], world_p[b])
+                         b, world_R[b], world_p[b], radii[b], simplices[pairs[k, 2]])  # fmt: skip
+        _remember(row, d, world_R[a], world_p[a], world_R[b], world_p[b])
         if self_pair and d < best_self:
             best_self = d
         elif not self_pair and d < best_obstacle:

@@ -23,18 +23,37 @@ def _compose(
 
 @jit()
 def _rotate_about(R: np.ndarray, axis: np.ndarray, angle: float, out: np.ndarray) -> None:
-    """out = R · Rot(axis, angle) (Rodrigues), axis a unit vector."""
-    c, s = np.cos(angle), np.sin(angle)
+    """out = R · Rot(axis, angle) (Rodrigues), axis a unit vector; about a coordinate axis
+    only two columns mix (most URDF joints: a third of the arithmetic)."""
+    c, s = math.cos(angle), math.sin(angle)
     x, y, z = axis[0], axis[1], axis[2]
-    C = 1.0 - c
-    r00, r01, r02 = c + x * x * C, x * y * C - z * s, x * z * C + y * s
-    r10, r11, r12 = y * x * C + z * s, c + y * y * C, y * z * C - x * s
-    r20, r21, r22 = z * x * C - y * s, z * y * C + x * s, c + z * z * C
-    for i in range(3):
-        a, b, d = R[i, 0], R[i, 1], R[i, 2]
-        out[i, 0] = a * r00 + b * r10 + d * r20
-        out[i, 1] = a * r01 + b * r11 + d * r21
-        out[i, 2] = a * r02 + b * r12 + d * r22
+    if x == 0.0 and y == 0.0 and z == 1.0:
+        _turn_columns(R, 0, 1, 2, c, s, out)
+    elif y == 0.0 and z == 0.0 and x == 1.0:
+        _turn_columns(R, 1, 2, 0, c, s, out)
+    elif z == 0.0 and x == 0.0 and y == 1.0:
+        _turn_columns(R, 2, 0, 1, c, s, out)
+    else:
+        C = 1.0 - c
+        r00, r01, r02 = c + x * x * C, x * y * C - z * s, x * z * C + y * s
+        r10, r11, r12 = y * x * C + z * s, c + y * y * C, y * z * C - x * s
+        r20, r21, r22 = z * x * C - y * s, z * y * C + x * s, c + z * z * C
+        for i in range(3):
+            a, b, d = R[i, 0], R[i, 1], R[i, 2]
+            out[i, 0] = a * r00 + b * r10 + d * r20
+            out[i, 1] = a * r01 + b * r11 + d * r21
+            out[i, 2] = a * r02 + b * r12 + d * r22
+
+
+@jit()
+def _turn_columns(R, i, j, k, c, s, out):  # fmt: skip
+    """out = R · Rot(e_k, angle) for the coordinate axis e_k, (i, j, k) a cyclic order:
+    columns i and j turn by (c, s) = (cos, sin) of the angle, column k stays."""
+    for m in range(3):
+        a, b = R[m, i], R[m, j]
+        out[m, i] = c * a + s * b
+        out[m, j] = c * b - s * a
+        out[m, k] = R[m, k]
 
 
 @jit()
@@ -148,20 +167,24 @@ def _moved(R0: np.ndarray, p0: np.ndarray, R: np.ndarray, p: np.ndarray, extent:
 
 
 @jit()
-def _remembered_bound(memory, a, b, world_R, world_p, extents):  # fmt: skip
-    """A pair's last exact distance less how far its shapes a and b moved since: a lower
-    bound of its distance now (−inf before its first exact distance)."""
+def _remembered_bound(memory, a, b, world_R, world_p, extents, shape_joint):  # fmt: skip
+    """A pair's last lower bound (an exact distance or a capsule gap) less how far its shapes a
+    and b moved since: a lower bound of its distance now (−inf before the first). A shape
+    on joint 0 (an obstacle) has not moved: CompiledClearance.at charges an obstacle's motion
+    to its pairs' memory when it puts it at a new pose."""
     if memory[0] == -np.inf:
         return -np.inf
-    R_a, p_a = memory[1:10].reshape(3, 3), memory[10:13]
-    R_b, p_b = memory[13:22].reshape(3, 3), memory[22:25]
-    return (memory[0] - _moved(R_a, p_a, world_R[a], world_p[a], extents[a])
-            - _moved(R_b, p_b, world_R[b], world_p[b], extents[b]))  # fmt: skip
+    bound = memory[0] - _moved(memory[1:10].reshape(3, 3), memory[10:13], world_R[a],
+                               world_p[a], extents[a])  # fmt: skip
+    if shape_joint[b] != 0:
+        bound -= _moved(memory[13:22].reshape(3, 3), memory[22:25], world_R[b], world_p[b],
+                        extents[b])  # fmt: skip
+    return bound
 
 
 @jit()
 def _remember(memory, d, R_a, p_a, R_b, p_b):  # fmt: skip
-    """Store a pair's exact distance d [m] and the poses of its shapes it was measured at."""
+    """Store a lower bound d [m] of a pair's distance and the poses of its shapes it holds at."""
     memory[0] = d
     memory[1:10] = R_a.ravel()
     memory[10:13] = p_a

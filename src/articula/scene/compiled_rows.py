@@ -41,7 +41,7 @@ def clearance_rows(
     """
     c = compiled
     out = _rows(q, c.parents, c.joint_rot, c.joint_p, c.axes, c.q_index, c.ee_joint, c.ee_p,
-                c.ee_rot, c.vertices, c.starts, c.neighbours, c.offsets, c.hints, c.guesses,
+                c.ee_rot, c.vertices, c.starts, c.neighbours, c.offsets, c.hints, c.simplices,
                 c.radii, c.shape_joint, c.shape_rot, c.shape_p, c.capsule_a, c.capsule_b,
                 c.capsule_r, c.pairs, c.cells, influence, q.size)  # fmt: skip
     return None if out[6] else out[:6]
@@ -85,7 +85,7 @@ def _jacobian(oR, op, axes, parents, q_index, joint, point, nq):  # fmt: skip
 @jit()
 def _rows(
     q, parents, joint_rot, joint_p, axes, q_index, ee_joint, ee_p, ee_rot, vertices, starts,
-    neighbours, offsets, hints, guesses, radii, shape_joint, shape_rot, shape_p, capsule_a,
+    neighbours, offsets, hints, simplices, radii, shape_joint, shape_rot, shape_p, capsule_a,
     capsule_b, capsule_r, pairs, cells, influence, nq,
 ):  # fmt: skip
     """clearance_rows in one compiled call; the last item flags an overlap."""
@@ -110,7 +110,7 @@ def _rows(
         a, b = pairs[k, 0], pairs[k, 1]
         d = gjk_witnesses(vertices, neighbours, offsets, hints,
                           a, world_R[a], world_p[a], radii[a],
-                          b, world_R[b], world_p[b], radii[b], guesses[pairs[k, 2]],
+                          b, world_R[b], world_p[b], radii[b], simplices[pairs[k, 2]],
                           point_a, point_b)  # fmt: skip
         if d <= 0.0:
             return ee, ee_R, J, np.zeros(0), np.zeros((0, nq)), np.zeros(0, np.bool_), True
