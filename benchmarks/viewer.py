@@ -8,10 +8,12 @@ tab connected when Debian's Chromium and Playwright are here (headless, software
 or with --no-browser, none, and `browser_connected` says so), paced at the scene's 10 ms
 period like `articula live`:
   live_period_ms          median wall time [ms] of one period: gizmo poses read, planner step,
-                          clearance recorded, and every DRAW_EVERY-th period (33 Hz) the arm,
-                          colours and readout pushed to the page (the worse method's)
+                          clearance recorded, and every DRAW_EVERY-th period (33 Hz) the arm's
+                          link poses, colours and readout computed and handed to the painter
+                          thread that pushes them to the page (the worse method's)
   live_overrun_fraction   fraction of periods longer than dt (the worse method's)
-  <method>_period_ms, <method>_overrun_fraction, <method>_planner_ms (the step alone)
+  <method>_period_ms, <method>_overrun_fraction, <method>_planner_ms (the step alone),
+  <method>_paint_ms       median wall time [ms] of one picture's push on the painter thread
 """
 
 from __future__ import annotations
@@ -28,7 +30,7 @@ import viser
 from common import run
 
 from articula.book.study import packaged
-from articula.viewer.live import Live
+from articula.viewer.live import Live, LiveScene
 
 METHODS = ("qp", "baornn-improved")
 
@@ -70,26 +72,15 @@ def measure(periods: int, no_browser: bool) -> dict[str, Any]:
         port = _port()
         server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
         try:
-            live = Live(server, scene_file, method)
-            with _tab(f"http://127.0.0.1:{port}", not no_browser) as page:
-                m["browser_connected"] = page is not None
-                for _ in range(20):  # warm-up: kernels, the page's first frames
-                    live.period()
-                walls, steps = [], []
-                next_period = time.perf_counter()
-                for _ in range(periods):
-                    start = time.perf_counter()
-                    steps.append(live.period())
-                    walls.append(time.perf_counter() - start)
-                    next_period += live.dt
-                    pause = next_period - time.perf_counter()
-                    if pause > 0:
-                        time.sleep(pause)
-                    else:
-                        next_period = time.perf_counter()
+            live = Live(server, LiveScene.load(scene_file, method))
+            try:
+                walls, steps = _paced(live, f"http://127.0.0.1:{port}", periods, no_browser, m)
+            finally:
+                live.close()
         finally:
             server.stop()
         key = method.replace("-", "_")
+        m[f"{key}_paint_ms"] = statistics.median(live.painter.paint_ms)
         m[f"{key}_period_ms"] = 1e3 * statistics.median(walls)
         m[f"{key}_planner_ms"] = 1e3 * statistics.median(steps)
         m[f"{key}_overrun_fraction"] = sum(w > live.dt for w in walls) / len(walls)
@@ -97,6 +88,30 @@ def measure(periods: int, no_browser: bool) -> dict[str, Any]:
     m["live_period_ms"] = max(m[f"{k.replace('-', '_')}_period_ms"] for k in METHODS)
     m["live_overrun_fraction"] = max(m[f"{k.replace('-', '_')}_overrun_fraction"] for k in METHODS)
     return m
+
+
+def _paced(
+    live: Live, url: str, periods: int, no_browser: bool, m: dict[str, Any]
+) -> tuple[list[float], list[float]]:
+    """(wall times, planner times) [s] of `periods` live periods paced at dt, a tab on url
+    unless `no_browser` (m["browser_connected"] says whether one was)."""
+    with _tab(url, not no_browser) as page:
+        m["browser_connected"] = page is not None
+        for _ in range(20):  # warm-up: kernels, the page's first frames
+            live.period()
+        walls, steps = [], []
+        next_period = time.perf_counter()
+        for _ in range(periods):
+            start = time.perf_counter()
+            steps.append(live.period())
+            walls.append(time.perf_counter() - start)
+            next_period += live.dt
+            pause = next_period - time.perf_counter()
+            if pause > 0:
+                time.sleep(pause)
+            else:
+                next_period = time.perf_counter()
+    return walls, steps
 
 
 def table(m: dict[str, Any]) -> tuple[str, list[str], list[list[str]]]:

@@ -115,6 +115,17 @@ def screenshot(page) -> np.ndarray:
     return np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB")).astype(int)
 
 
+def keep_screenshot(page, name: str, folder: Path) -> None:
+    """Save the tab as folder/name, and also under $ARTICULA_SCREENSHOTS when that is set
+    (`ARTICULA_SCREENSHOTS=docs/img pytest tests/viewer` refreshes the documentation's)."""
+    png = page.screenshot()
+    (folder / name).write_bytes(png)
+    if os.environ.get("ARTICULA_SCREENSHOTS"):
+        kept = Path(os.environ["ARTICULA_SCREENSHOTS"])
+        kept.mkdir(parents=True, exist_ok=True)
+        (kept / name).write_bytes(png)
+
+
 def robot_mask(image: np.ndarray) -> np.ndarray:
     """Pixels of the robot in the 3-D view (left of the panel, right of the software-WebGL
     notice's orange bar): its orange, shaded toward red near obstacles, in any light: red

@@ -6,6 +6,7 @@ the page renders in Chromium."""
 from __future__ import annotations
 
 import signal
+import time
 
 import numpy as np
 import pytest
@@ -15,9 +16,16 @@ import viser
 from articula.scene import Obstacle, Scene
 from articula.validation import load_toml
 from articula.viewer.drawing import pose_of
-from articula.viewer.live import Live
+from articula.viewer.live import Live, LiveScene
 from articula.viewer.run_data import load_run
-from tests.viewer.conftest import CONFIGS, free_port, open_page, robot_mask, screenshot
+from tests.viewer.conftest import (
+    CONFIGS,
+    free_port,
+    keep_screenshot,
+    open_page,
+    robot_mask,
+    screenshot,
+)
 
 
 @pytest.fixture
@@ -41,7 +49,7 @@ def server():
 
 @pytest.mark.parametrize("method", ["qp", "baornn-improved"])
 def test_an_obstacle_pushed_into_the_arm_is_avoided(server, scene_file, tmp_path, method):
-    live = Live(server, scene_file, method)
+    live = Live(server, LiveScene.load(scene_file, method))
     d_min = live.controller.planner.d_min
     for _ in range(100):  # 1 s along the circle
         live.period()
@@ -61,7 +69,10 @@ def test_an_obstacle_pushed_into_the_arm_is_avoided(server, scene_file, tmp_path
     after = live.recording.clearance[100:]
     assert before - min(after) > 0.05  # the reported clearance follows the rock
     assert min(after) > d_min  # and the planner keeps out of its way
+    assert live.painter.flush()
     assert "clearance" in live.readout.content
+    assert live.painter.paint_ms  # the pictures went out on the painter's thread
+    live.close()
     record = live.write(tmp_path / "rec", 1.0)
     assert record["metrics"]["collisions"] == 0
     replay = load_run(tmp_path / "rec")
@@ -71,7 +82,7 @@ def test_an_obstacle_pushed_into_the_arm_is_avoided(server, scene_file, tmp_path
 
 
 def test_the_panel_rebuilds_the_controller_and_refuses_a_start_within_d_min(server, scene_file):
-    live = Live(server, scene_file, "qp")
+    live = Live(server, LiveScene.load(scene_file, "qp"))
     for _ in range(5):
         live.period()
     live.method.value = "baornn-improved"
@@ -84,11 +95,36 @@ def test_the_panel_rebuilds_the_controller_and_refuses_a_start_within_d_min(serv
     assert live.controller is old and "not changed" in live.readout.content
 
 
-def test_the_live_page_renders_and_ctrl_c_writes_the_record(scene_file, viewer, browser, tmp_path):
+def test_the_live_page_renders_in_two_tabs_and_ctrl_c_writes_the_record(
+    scene_file, viewer, browser, tmp_path
+):
     proc, url = viewer("live", scene_file, "--method", "qp", "--record", tmp_path / "rec")
-    page = open_page(browser, url, wait_for="clearance")
-    assert robot_mask(screenshot(page)).sum() > 2000
+    pages = [open_page(browser, url, wait_for="clearance") for _ in range(2)]
+    for page in pages:
+        assert robot_mask(screenshot(page)).sum() > 2000
+    keep_screenshot(pages[0], "live.png", tmp_path)
+    browser.close()
+    time.sleep(1.0)
+    assert proc.poll() is None  # the tabs went, the loop goes on
     proc.send_signal(signal.SIGINT)
     assert proc.wait(30) == 0
     run = load_run(tmp_path / "rec")
     assert len(run.t) > 10 and run.clearance.min() > 0
+
+
+@pytest.mark.parametrize(
+    ("change", "field"),
+    [({"d_min": -1.0}, "d_min"), ({"d_min": 5.0}, "d_min")],
+    ids=["invalid", "cannot-start"],
+)
+def test_a_bad_scene_is_one_line_and_exit_2_before_any_server_opens(
+    scene_file, tmp_path, cli, change, field
+):
+    config = load_toml(scene_file)
+    config["planner"] |= change
+    bad = tmp_path / "bad.toml"
+    bad.write_text(tomli_w.dumps(config))
+    proc = cli("live", bad, "--port", str(free_port()))
+    assert proc.returncode == 2
+    assert len(proc.stderr.strip().splitlines()) == 1 and field in proc.stderr
+    assert "viser" not in proc.stdout + proc.stderr  # no server was opened

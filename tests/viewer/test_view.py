@@ -10,7 +10,7 @@ import urllib.request
 
 import numpy as np
 
-from tests.viewer.conftest import free_port, open_page, robot_mask, screenshot
+from tests.viewer.conftest import free_port, keep_screenshot, open_page, robot_mask, screenshot
 
 
 def test_a_run_renders_and_the_slider_moves_the_arm(planned_run, viewer, browser, tmp_path):
@@ -29,7 +29,7 @@ def test_a_run_renders_and_the_slider_moves_the_arm(planned_run, viewer, browser
     second = screenshot(page)
     moved = robot_mask(second) ^ arm
     assert moved.sum() > 300, moved.sum()  # the arm is elsewhere in the picture
-    (tmp_path / "view.png").write_bytes(page.screenshot())
+    keep_screenshot(page, "view.png", tmp_path)
 
 
 def test_two_tabs_and_a_closed_browser_leave_the_server_serving(planned_run, viewer, browser):

@@ -29,6 +29,7 @@ from articula.scene.compiled_poses import (
     _capsule_gaps,
     _ee_pose,
     _joint_poses,
+    _moved,
     _remember,
     _remembered_bound,
     _segment_distance,
@@ -168,14 +169,8 @@ class CompiledClearance:
         """Put the moving obstacles' shapes at their poses of time t [s] (in place), and lower
         the remembered bounds of their pairs by how far each moved."""
         for shape, obstacle in self.moving_parts:
-            T = obstacle.pose_at(t)
-            R0, p0 = self.shape_rot[shape], self.shape_p[shape]
-            turn = math.sqrt(max(3.0 - float(np.sum(R0 * T[:3, :3])), 0.0))
-            moved = float(np.linalg.norm(T[:3, 3] - p0)) + turn * self.extents[shape]
-            if moved > 0.0:
-                self.memory[self.pairs[self.pairs[:, 1] == shape, 2], 0] -= moved
-                self.shape_rot[shape] = T[:3, :3]
-                self.shape_p[shape] = T[:3, 3]
+            _place(shape, obstacle.pose_at(t), self.shape_rot, self.shape_p, self.extents,
+                   self.memory, self.pairs)  # fmt: skip
 
     no_pairs: ClassVar[np.ndarray] = np.zeros((0, 5), dtype=np.int64)  # kinematics only
 
@@ -278,6 +273,20 @@ def _capsule_ends(shape: ConvexShape) -> tuple[np.ndarray, np.ndarray, float]:
     """The bounding capsule as its two segment ends (shape frame) and radius."""
     T, half = shape.bound.pose, shape.bound.length / 2
     return T[:3, 3] - half * T[:3, 2], T[:3, 3] + half * T[:3, 2], shape.bound.radius
+
+
+@jit()
+def _place(shape, T, shape_rot, shape_p, extents, memory, pairs):  # fmt: skip
+    """Put an obstacle's shape at pose T (4×4, world), lowering the remembered bound of each
+    of its pairs by how far it moved."""
+    R, p = np.ascontiguousarray(T[:3, :3]), np.ascontiguousarray(T[:3, 3])
+    moved = _moved(shape_rot[shape], shape_p[shape], R, p, extents[shape])
+    if moved > 0.0:
+        for k in range(pairs.shape[0]):
+            if pairs[k, 1] == shape:
+                memory[pairs[k, 2], 0] -= moved
+        shape_rot[shape] = R
+        shape_p[shape] = p
 
 
 @jit()

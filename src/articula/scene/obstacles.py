@@ -44,10 +44,14 @@ class Obstacle:
 
 def check_pose(what: str, T: np.ndarray) -> np.ndarray:
     """T if it is a finite 4×4 pose with a rotation; GeometryError that starts with `what`
-    (e.g. "obstacle 'box'")."""
-    if T.shape != (4, 4) or not np.all(np.isfinite(T)):
+    (e.g. "obstacle 'box'"). Cheap: a live loop checks every obstacle pose every period."""
+    if T.shape != (4, 4) or not np.isfinite(T).all():
         raise GeometryError(f"{what}: pose must be a finite 4×4 matrix (got {T.shape})")
-    R = T[:3, :3]
-    if not np.allclose(R @ R.T, np.eye(3), atol=1e-6) or np.linalg.det(R) < 0:
+    # det R and the entries of R Rᵀ − I, in scalars: numpy's per-call overhead would dominate.
+    (a, b, c), (d, e, f), (g, h, i) = T[:3, :3].tolist()
+    det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+    gram = (a * a + b * b + c * c - 1.0, d * d + e * e + f * f - 1.0, g * g + h * h + i * i - 1.0,
+            a * d + b * e + c * f, a * g + b * h + c * i, d * g + e * h + f * i)  # fmt: skip
+    if max(map(abs, gram)) > 1e-5 or det < 0:
         raise GeometryError(f"{what}: pose rotation is not a rotation matrix")
     return T

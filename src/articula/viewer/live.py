@@ -1,9 +1,11 @@
 """`articula live`: a scene's planner in real time in the browser, obstacles dragged by hand.
 
 Every control period reads each obstacle's drag gizmo, steps the same OnlineController that
-`articula plan` uses (its obstacles live), and moves the arm on the page. The end-effector
-target follows the scene's trajectory or a gizmo of its own; the method, Λ and d_min can be
-changed from the panel (the controller is rebuilt from the arm's current configuration).
+`articula plan` uses (its obstacles live), and hands the arm's picture to a painter thread
+that moves it on the page (viewer/painter.py: the loop never waits on the browser). The
+end-effector target follows the scene's trajectory or a gizmo of its own; the method, Λ and
+d_min can be changed from the panel (the controller is rebuilt from the arm's current
+configuration).
 """
 
 from __future__ import annotations
@@ -24,14 +26,16 @@ from articula.planning.target_path import TargetPath
 from articula.runs.records import build_record, write_run
 from articula.runs.registry import Result
 from articula.scene.config import build_scene, load_scene_spec
+from articula.scene.scene import Scene
 from articula.validation import load_toml
 from articula.viewer import drawing
+from articula.viewer.painter import Painter
 from articula.viewer.run_data import PLAN, TRACK, visuals_of
 
 METHODS = ("baornn", "baornn-improved", "pinv", "dls", "qp")
 READOUT_EVERY = 10  # periods between readout updates (a person reads at most ~10 a second)
-DRAW_EVERY = 3  # periods between page updates: 33 Hz at 10 ms, smooth to the eye; the
-# control loop keeps its own rate (a page update costs ~2 ms of viser messages)
+DRAW_EVERY = 3  # periods between pictures: 33 Hz at 10 ms, smooth to the eye (each is
+# pushed to the page by the painter's thread, viewer/painter.py: the loop never waits on it)
 
 
 @dataclass
@@ -47,17 +51,37 @@ class Recording:
     obstacles: dict[str, list[np.ndarray]] = field(default_factory=dict)
 
 
+@dataclass
+class LiveScene:
+    """A scene file read and checked for `live`: its plan config (the method given, if one
+    was), scene, start configuration [rad] and end-effector path."""
+
+    config: dict[str, Any]
+    scene: Scene
+    q0: np.ndarray
+    targets: TargetPath
+
+    @classmethod
+    def load(cls, scene_file: Path, method: str | None = None) -> LiveScene:
+        """Read scene_file; an ArticulaError (before any server opens) when its planner does
+        not validate or cannot start from its q0."""
+        config = _plan_config(scene_file)
+        if method is not None:
+            config["planner"]["method"] = method
+        scene, q0 = build_scene(load_scene_spec(config), scene_file.parent)
+        targets = make_targets(TrajectorySpec(**config["trajectory"]), scene_file.parent)
+        spec = PlannerSpec(**config["planner"])
+        OnlineController.from_spec(scene, spec, int(spec.seed or 0), live_obstacles=True).reset(q0)
+        return cls(config, scene, q0, targets)
+
+
 class Live:
     """The live page of one scene file in one viser server."""
 
-    def __init__(self, server: viser.ViserServer, scene_file: Path, method: str | None) -> None:
+    def __init__(self, server: viser.ViserServer, loaded: LiveScene) -> None:
         self.server = server
-        self.config = _plan_config(scene_file)
-        if method is not None:
-            self.config["planner"]["method"] = method
-        self.scene, self.q0 = build_scene(load_scene_spec(self.config), scene_file.parent)
-        self.targets: TargetPath = make_targets(TrajectorySpec(**self.config["trajectory"]),
-                                                scene_file.parent)  # fmt: skip
+        self.config = loaded.config
+        self.scene, self.q0, self.targets = loaded.scene, loaded.q0, loaded.targets
         planner = self.config["planner"]
         gui = server.gui
         self.method = gui.add_dropdown(
@@ -86,7 +110,8 @@ class Live:
                                                           disable_rotations=True)  # fmt: skip
         server.scene.add_icosphere("/target/ball", radius=0.01, color=drawing.REFERENCE_COLOUR)
         self.recording = Recording()
-        self.colours: dict[str, tuple[int, int, int]] = {}
+        self.colours: dict[str, tuple[int, int, int]] = {}  # as painted (painter's thread)
+        self.painter = Painter(server)
         self.periods = 0
         self.step_ms: list[float] = []
         self.controller: OnlineController | None = None
@@ -169,29 +194,49 @@ class Live:
     def _draw(
         self, d: np.ndarray, x: np.ndarray, target: np.ndarray, clearance: float, elapsed: float
     ) -> None:
-        """Move the arm, colour its links by clearance (d: links × obstacles [m]) and write the
-        readout (every READOUT_EVERY periods, or when over the period): one batch of messages."""
+        """Hand the painter the arm's link poses, its links' colours by clearance (d: links ×
+        obstacles [m]) and the readout (every READOUT_EVERY periods, or when over the
+        period)."""
         scene = self.controller.planner.scene
         late = elapsed > self.dt
-        with self.server.atomic():
-            if self.follow.value:
-                self.target.position = target
-            for name, T in scene.robot.link_poses(self.q).items():
-                if name in self.frames:
-                    self.frames[name].wxyz, self.frames[name].position = drawing.wxyz_position(T)
-            for i, link in enumerate(scene.robot.links):
-                colour = drawing.clearance_colour(float(d[i].min()), float(self.d_min.value))
-                if self.colours.get(link.name) != colour:  # only what changed goes out
-                    self.colours[link.name] = colour
-                    for mesh in self.meshes.get(link.name, ()):
-                        mesh.color = colour
-            if late or self.periods % READOUT_EVERY == 0:
-                error = float(np.linalg.norm(x - target))
-                self.readout.content = (
-                    f"clearance **{1e3 * clearance:.1f} mm** · error {1e3 * error:.2f} mm"
-                    f" · planner {1e3 * elapsed:.2f} ms per {1e3 * self.dt:.0f} ms period"
-                    + (" · **over the period**" if late else "")
-                )
+        poses = scene.robot.link_poses(self.q)
+        frames = {name: drawing.wxyz_position(poses[name]) for name in self.frames if name in poses}
+        d_min = float(self.d_min.value)
+        colours = {link.name: drawing.clearance_colour(float(d[i].min()), d_min)
+                   for i, link in enumerate(scene.robot.links)}  # fmt: skip
+        readout = None
+        if late or self.periods % READOUT_EVERY == 0:
+            error = float(np.linalg.norm(x - target))
+            readout = (f"clearance **{1e3 * clearance:.1f} mm** · error {1e3 * error:.2f} mm"
+                       f" · planner {1e3 * elapsed:.2f} ms per {1e3 * self.dt:.0f} ms period"
+                       + (" · **over the period**" if late else ""))  # fmt: skip
+        shown = target.copy() if self.follow.value else None
+        self.painter.post(lambda: self._paint(frames, colours, readout, shown))
+
+    def _paint(
+        self,
+        frames: dict[str, tuple[np.ndarray, np.ndarray]],
+        colours: dict[str, tuple[int, int, int]],
+        readout: str | None,
+        target: np.ndarray | None,
+    ) -> None:
+        """On the painter's thread: move the arm (and the target it follows), recolour the
+        links whose colour changed since the last picture, write the readout."""
+        if target is not None:
+            self.target.position = target
+        for name, (wxyz, position) in frames.items():
+            self.frames[name].wxyz, self.frames[name].position = wxyz, position
+        for name, colour in colours.items():
+            if self.colours.get(name) != colour:  # only what changed goes out
+                self.colours[name] = colour
+                for mesh in self.meshes.get(name, ()):
+                    mesh.color = colour
+        if readout is not None:
+            self.readout.content = readout
+
+    def close(self) -> None:
+        """Stop the painter (after its last picture)."""
+        self.painter.stop()
 
     def _gizmo_poses(self) -> dict[str, np.ndarray]:
         """Every obstacle's pose (4×4, world) from its gizmo."""
@@ -238,11 +283,12 @@ def run_live(scene_file: Path, method: str | None, host: str, port: int, record:
     """Serve the live page until Ctrl-C, a period every dt; then write --record if asked."""
     from articula.viewer.replay import open_server
 
+    loaded = LiveScene.load(scene_file, method)  # a bad file fails before the port opens
     server = open_server(host, port)
     started = time.monotonic()
     live = None
     try:
-        live = Live(server, scene_file, method)
+        live = Live(server, loaded)
         announce(f"http://{host}:{port}")
         next_period = time.perf_counter()
         while True:
@@ -256,6 +302,8 @@ def run_live(scene_file: Path, method: str | None, host: str, port: int, record:
     except KeyboardInterrupt:
         pass
     finally:
+        if live is not None:
+            live.close()
         server.stop()
     if record is not None and live is not None:
         live.write(record, time.monotonic() - started)
