@@ -30,6 +30,7 @@ from articula.scene.compiled_poses import (
     _ee_pose,
     _joint_poses,
     _moved,
+    _place_ends,
     _remember,
     _remembered_bound,
     _segment_distance,
@@ -280,7 +281,8 @@ def _place(shape, T, shape_rot, shape_p, extents, memory, pairs):  # fmt: skip
     """Put an obstacle's shape at pose T (4×4, world), lowering the remembered bound of each
     of its pairs by how far it moved."""
     R, p = np.ascontiguousarray(T[:3, :3]), np.ascontiguousarray(T[:3, 3])
-    moved = _moved(shape_rot[shape], shape_p[shape], R, p, extents[shape])
+    before = np.concatenate((shape_rot[shape].ravel(), shape_p[shape])).reshape(1, 12)
+    moved = _moved(before, 0, 0, R.reshape(1, 3, 3), p.reshape(1, 3), 0, extents[shape])
     if moved > 0.0:
         for k in range(pairs.shape[0]):
             if pairs[k, 1] == shape:
@@ -348,12 +350,12 @@ def _evaluate(
     oR, op = _joint_poses(q, parents, joint_rot, joint_p, axes, q_index)
     ee, ee_R = _ee_pose(oR, op, ee_joint, ee_p, ee_rot)
     world_R, world_p, ends = _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a,
-                                          capsule_b, pairs)  # fmt: skip
+                                          capsule_b, pairs, False)  # fmt: skip
     npairs = pairs.shape[0]
     lower = np.empty(npairs)
     has_obstacle = has_self = False  # a kind without pairs here cannot improve
     for k in range(npairs):
-        lower[k] = _remembered_bound(memory[pairs[k, 2]], pairs[k, 0], pairs[k, 1], world_R,
+        lower[k] = _remembered_bound(memory, pairs[k, 2], pairs[k, 0], pairs[k, 1], world_R,
                                      world_p, extents, shape_joint)  # fmt: skip
         if pairs[k, 3] == 1:
             has_self = True
@@ -378,6 +380,8 @@ def _evaluate(
             continue
         a, b = pairs[k, 0], pairs[k, 1]
         row = memory[pairs[k, 2]]
+        _place_ends(a, world_R, world_p, capsule_a, capsule_b, ends)
+        _place_ends(b, world_R, world_p, capsule_a, capsule_b, ends)
         gap = _segment_distance(ends[a, 0], ends[a, 1], ends[b, 0], ends[b, 1])
         gap -= capsule_r[a] + capsule_r[b]
         if gap >= best:

@@ -124,9 +124,11 @@ def _ee_pose(oR, op, ee_joint, ee_p, ee_rot):  # fmt: skip
 
 
 @jit()
-def _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a, capsule_b, pairs):  # fmt: skip
-    """World pose of every shape of `pairs` and the ends of its bounding capsule's segment
-    (the other shapes' rows are left unset: a far obstacle costs nothing here)."""
+def _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a, capsule_b, pairs,
+                 ends_too=True):  # fmt: skip
+    """World pose of every shape of `pairs` and (with ends_too; else unset, see _place_ends)
+    the ends of its bounding capsule's segment (the other shapes' rows are left unset: a far
+    obstacle costs nothing here)."""
     ns = shape_joint.size
     world_R = np.empty((ns, 3, 3))
     world_p = np.empty((ns, 3))
@@ -138,9 +140,16 @@ def _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a, capsule_b, 
                 done[s] = True
                 j = shape_joint[s]
                 _compose(oR[j], op[j], shape_rot[s], shape_p[s], world_R[s], world_p[s])
-                _apply(world_R[s], world_p[s], capsule_a[s], ends[s, 0])
-                _apply(world_R[s], world_p[s], capsule_b[s], ends[s, 1])
+                if ends_too:
+                    _place_ends(s, world_R, world_p, capsule_a, capsule_b, ends)
     return world_R, world_p, ends
+
+
+@jit()
+def _place_ends(s, world_R, world_p, capsule_a, capsule_b, ends):  # fmt: skip
+    """ends[s] = the world ends of shape s's bounding capsule segment."""
+    _apply(world_R[s], world_p[s], capsule_a[s], ends[s, 0])
+    _apply(world_R[s], world_p[s], capsule_b[s], ends[s, 1])
 
 
 @jit()
@@ -155,30 +164,32 @@ def _capsule_gaps(ends, capsule_r, pairs):  # fmt: skip
 
 
 @jit()
-def _moved(R0: np.ndarray, p0: np.ndarray, R: np.ndarray, p: np.ndarray, extent: float) -> float:
-    """A bound [m] on how far any point within `extent` of a shape's origin moved from pose
-    (R0, p0) to (R, p): |p − p0| + ||R − R0||₂ extent, ||R − R0||₂ = √(3 − tr(R0ᵀ R))."""
+def _moved(memory, row, at, world_R, world_p, s, extent):  # fmt: skip
+    """A bound [m] on how far any point within `extent` of shape s's origin moved from the
+    pose (R0, p0) stored in memory[row, at:at + 12] (R0 row-major, then p0) to its pose now,
+    (world_R[s], world_p[s]): |p − p0| + ||R − R0||₂ extent, ||R − R0||₂ = √(3 − tr(R0ᵀ R)).
+    Indices, not views: a view costs two atomic reference counts, more than the arithmetic."""
     trace = 0.0
     for i in range(3):
         for k in range(3):
-            trace += R0[i, k] * R[i, k]
-    dx, dy, dz = p[0] - p0[0], p[1] - p0[1], p[2] - p0[2]
+            trace += memory[row, at + 3 * i + k] * world_R[s, i, k]
+    dx = world_p[s, 0] - memory[row, at + 9]
+    dy = world_p[s, 1] - memory[row, at + 10]
+    dz = world_p[s, 2] - memory[row, at + 11]
     return math.sqrt(dx * dx + dy * dy + dz * dz) + math.sqrt(max(3.0 - trace, 0.0)) * extent
 
 
 @jit()
-def _remembered_bound(memory, a, b, world_R, world_p, extents, shape_joint):  # fmt: skip
-    """A pair's last lower bound (an exact distance or a capsule gap) less how far its shapes a
-    and b moved since: a lower bound of its distance now (−inf before the first). A shape
-    on joint 0 (an obstacle) has not moved: CompiledClearance.at charges an obstacle's motion
-    to its pairs' memory when it puts it at a new pose."""
-    if memory[0] == -np.inf:
+def _remembered_bound(memory, row, a, b, world_R, world_p, extents, shape_joint):  # fmt: skip
+    """The last lower bound of a pair (memory[row]: an exact distance or a capsule gap) less
+    how far its shapes a and b moved since: a lower bound of its distance now (−inf before
+    the first). A shape on joint 0 (an obstacle) has not moved: CompiledClearance.at charges
+    an obstacle's motion to its pairs' memory when it puts it at a new pose."""
+    if memory[row, 0] == -np.inf:
         return -np.inf
-    bound = memory[0] - _moved(memory[1:10].reshape(3, 3), memory[10:13], world_R[a],
-                               world_p[a], extents[a])  # fmt: skip
+    bound = memory[row, 0] - _moved(memory, row, 1, world_R, world_p, a, extents[a])
     if shape_joint[b] != 0:
-        bound -= _moved(memory[13:22].reshape(3, 3), memory[22:25], world_R[b], world_p[b],
-                        extents[b])  # fmt: skip
+        bound -= _moved(memory, row, 13, world_R, world_p, b, extents[b])
     return bound
 
 
