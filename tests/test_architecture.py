@@ -28,11 +28,12 @@ LAYERS = {
     "planning": 7,
     "loops": 8,
     "runs": 9,
-    "book": 10,
-    "bench": 10,
-    "viewer": 10,
-    "cli": 11,
-    "__main__": 12,
+    "rigs": 10,
+    "book": 11,
+    "bench": 11,
+    "viewer": 11,
+    "cli": 12,
+    "__main__": 13,
 }
 MAX_LINES = 400
 

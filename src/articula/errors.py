@@ -49,3 +49,9 @@ class CollisionError(ArticulaError, RuntimeError):
 
 class DeviceError(ArticulaError, OSError):
     """A bench rig or serial device failed or answered out of protocol."""
+
+
+class PortError(ArticulaError, ValueError):
+    """A rig's serial port cannot be used: it does not exist, nothing on it answers the
+    handshake, or the device is another rig or speaks another protocol version (bad input:
+    the command line exits with status 2; a rig failing mid-run is a DeviceError)."""

@@ -16,7 +16,7 @@ from typing import NoReturn
 
 from typer.exceptions import Abort, Exit, TyperException
 
-from articula.cli import arm, bench, book, runs, viewer  # noqa: F401  (each module adds its commands to app)
+from articula.cli import arm, bench, book, rigs, runs, viewer  # noqa: F401  (each module adds its commands to app)
 from articula.cli.app import app
 from articula.errors import ArticulaError, CollisionError, DeviceError, ResourceError
 

@@ -6,6 +6,7 @@ noise every time), so the tuners see exactly what they would see on a real rig.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Annotated
 
@@ -79,12 +80,22 @@ def manual_run(config: TuningConfig, level: float) -> ManualResult:
     return manual_tuning(rig, settings)
 
 
-def auto_run(config: TuningConfig, levels: tuple[float, ...], index: int) -> TuningRun:
-    """Coordinate descent of M (2.5) on steps through `levels` [°]; `index` picks the seed."""
+def auto_run(
+    config: TuningConfig,
+    levels: tuple[float, ...],
+    index: int,
+    rig: Callable[[np.ndarray], Response] | None = None,
+) -> TuningRun:
+    """Coordinate descent of M (2.5) on steps through `levels` [°]; `index` picks the seed.
+
+    `rig` runs one experiment with gains K [K_p, K_i, K_d] and returns its response; by
+    default the simulated actuator (SimulatedRig, noise seed `auto_seed(config, index)`),
+    else, e.g., rigs.pneunet.PneuNetRig on a real or emulated rig with the same program."""
     a = config.auto
-    reference = step_reference(levels, a.hold, config.plant.pwm_period)
     rng = np.random.default_rng([a.seed, index])
-    rig = SimulatedRig(config.plant, reference, a.seed * 1000 + index * 100_000)
+    if rig is None:
+        reference = step_reference(levels, a.hold, config.plant.pwm_period)
+        rig = SimulatedRig(config.plant, reference, auto_seed(config, index))
 
     def cost(k: np.ndarray) -> float:
         r = rig(k)
@@ -96,6 +107,11 @@ def auto_run(config: TuningConfig, levels: tuple[float, ...], index: int) -> Tun
         cost, k0, dk0, a.k_stop, a.max_iterations, lower=np.zeros(3), upper=np.array(a.upper)
     )
     return TuningRun(levels, result)
+
+
+def auto_seed(config: TuningConfig, index: int) -> int:
+    """The first noise seed of tuning run `index` (each experiment of the run takes the next)."""
+    return config.auto.seed * 1000 + index * 100_000
 
 
 @dataclass(frozen=True, eq=False)

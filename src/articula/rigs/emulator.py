@@ -1,0 +1,210 @@
+"""A rig's device emulated behind a pseudo-terminal: the host opens its path with pyserial as
+it would open /dev/ttyACM0, and the simulated plant answers in the protocol.
+
+`--fast` runs samples as fast as the host reads them (the pty's buffer holds the device back
+when the host lags); `--realtime` paces them at the rig's sample period. Faults can be
+injected on the device's frames: drop (probability a frame is not sent), corrupt (probability
+one of its bytes is flipped), delay_ms (before every reply to a command) and reset_at (the
+device restarts at that run time [s]: the run ends, its count starts again from 0 and it
+announces itself with an INFO).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import select
+import struct
+import threading
+import time
+import tty
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from articula.errors import ConfigError, DeviceError
+from articula.rigs import protocol
+from articula.rigs.protocol import ErrorCode, Frame, Info, Kind
+
+
+class Device(Protocol):
+    """A rig's program: what the emulator runs for each command and sample."""
+
+    info: Info
+
+    def configure(self, kind: int, body: bytes) -> None: ...
+
+    def start(self, duration: float, seed: int) -> None: ...
+
+    def sample(self) -> np.ndarray | None: ...
+
+    def stop(self) -> None: ...
+
+
+@dataclass(frozen=True)
+class Faults:
+    """Faults injected on the device's side of the line (module docstring)."""
+
+    drop: float = 0.0
+    corrupt: float = 0.0
+    delay_ms: float = 0.0
+    reset_at: float | None = None
+
+    @classmethod
+    def parse(cls, text: str) -> Faults:
+        """Faults from "drop=0.01,corrupt=0.01,delay_ms=20,reset_at=5.0" (any of them)."""
+        values: dict[str, float] = {}
+        for item in filter(None, (part.strip() for part in text.split(","))):
+            name, _, value = item.partition("=")
+            if name not in cls.__dataclass_fields__:
+                known = ", ".join(cls.__dataclass_fields__)
+                raise ConfigError("--faults", f"unknown fault {name!r}; known: {known}")
+            try:
+                values[name] = float(value)
+            except ValueError:
+                raise ConfigError("--faults", f"{name} needs a number (got {value!r})") from None
+        for name in ("drop", "corrupt"):
+            if not 0.0 <= values.get(name, 0.0) < 1.0:
+                raise ConfigError("--faults", f"{name} is a probability in [0, 1)")
+        return cls(**values)
+
+
+class Emulator:
+    """A device behind a pty; `path` is what the host opens. serve() answers until stop()."""
+
+    def __init__(
+        self, device: Device, realtime: bool = False, faults: Faults | None = None, seed: int = 0
+    ) -> None:
+        self.device, self.realtime, self.faults = device, realtime, faults or Faults()
+        self._master, self._slave = os.openpty()
+        tty.setraw(self._slave)  # bytes as they are: no echo, no line editing, no ^C
+        self.path = os.ttyname(self._slave)
+        self._rng = np.random.default_rng(seed)  # the faults' draws
+        self._deframer = protocol.Deframer()
+        self._stopped = threading.Event()
+        self._seq = 0
+        self._run: tuple[int, int, float] | None = None  # (START's seq, samples, start time)
+        self._last_start: int | None = None  # the START last carried out (a resend is not)
+        self._samples = 0  # samples of the last run
+        self._decimation = 1
+        self._thread: threading.Thread | None = None
+
+    def serve(self) -> None:
+        """Answer commands and run the device until stop() (or the pty closes)."""
+        while not self._stopped.is_set():
+            busy = self._run is not None
+            wait = 0.0 if busy and not self.realtime else (self._due() if busy else 0.05)
+            ready, _, _ = select.select([self._master], [], [], max(wait, 0.0))
+            if ready:
+                try:
+                    data = os.read(self._master, 4096)
+                except OSError:
+                    return  # the pty is gone
+                for raw in self._deframer.feed(data):
+                    self._handle(raw)
+            if self._run is not None and self._due() <= 0.0:
+                self._step()
+
+    def start(self) -> Emulator:
+        """serve() on a daemon thread; returns the emulator."""
+        self._thread = threading.Thread(target=self.serve, name="articula-emulator", daemon=True)
+        self._thread.start()
+        return self
+
+    def stop(self) -> None:
+        """End serve() and close the pty (the host then sees the line go down)."""
+        self._stopped.set()
+        if self._thread is not None:
+            self._thread.join(timeout=2.0)
+        for fd in (self._master, self._slave):
+            with contextlib.suppress(OSError):
+                os.close(fd)
+
+    def __enter__(self) -> Emulator:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    def _due(self) -> float:
+        """Seconds until the next sample is due (realtime), 0 when running fast."""
+        if self._run is None or not self.realtime:
+            return 0.0
+        _, samples, started = self._run
+        period = self.device.info.sample_period_us * 1e-6
+        return started + samples * period - time.monotonic()
+
+    def _handle(self, raw: bytes) -> None:
+        """Decode one command and answer it (a damaged one is ignored: the host resends)."""
+        try:
+            frame = protocol.decode(raw)
+        except DeviceError:
+            return
+        if self.faults.delay_ms:
+            time.sleep(self.faults.delay_ms * 1e-3)
+        try:
+            self._execute(frame)
+        except (DeviceError, struct.error) as exc:
+            self._send(Kind.ERROR, struct.pack("<HB", frame.seq, ErrorCode.BAD_VALUE)
+                       + str(exc).encode("ascii", "replace")[:200])  # fmt: skip
+
+    def _execute(self, frame: Frame) -> None:
+        """Carry out one command and acknowledge it."""
+        if frame.kind == Kind.HELLO:
+            self._send(Kind.INFO, protocol.encode_info(self.device.info))
+            return
+        status = b""
+        if frame.kind == Kind.START:
+            if self._run is not None and self._run[0] != frame.seq:
+                raise DeviceError("a run is going on; STOP it first")
+            if frame.seq != self._last_start:  # a START sent again is only acknowledged
+                duration, seed = struct.unpack("<fI", frame.body)
+                self.device.start(duration, seed)
+                self._run, self._last_start = (frame.seq, 0, time.monotonic()), frame.seq
+        elif frame.kind == Kind.STATUS:
+            samples = self._run[1] if self._run is not None else self._samples
+            status = struct.pack("<BI", self._run is not None, samples)
+        elif frame.kind == Kind.STOP:
+            self.device.stop()
+            self._run = None
+        elif frame.kind == Kind.STREAM:
+            (self._decimation,) = struct.unpack("<H", frame.body)
+        else:
+            self.device.configure(frame.kind, frame.body)
+        self._send(Kind.ACK, struct.pack("<H", frame.seq) + status)
+
+    def _step(self) -> None:
+        """One sample of the run; its telemetry; DONE at its end; a reset when one is due."""
+        seq, samples, started = self._run
+        period = self.device.info.sample_period_us * 1e-6
+        if self.faults.reset_at is not None and samples * period >= self.faults.reset_at:
+            self.device.stop()
+            self._run, self._seq, self._last_start = None, 0, None
+            self.faults = Faults(self.faults.drop, self.faults.corrupt, self.faults.delay_ms)
+            self._send(Kind.INFO, protocol.encode_info(self.device.info))
+            return
+        values = self.device.sample()
+        if values is None:
+            self._run, self._samples = None, samples
+            self._send(Kind.DONE, struct.pack("<HI", seq, samples))
+            return
+        self._run = (seq, samples + 1, started)
+        if self._decimation and samples % self._decimation == 0:
+            micros = round(samples * self.device.info.sample_period_us) & 0xFFFFFFFF
+            self._send(Kind.TELEMETRY, struct.pack("<I", micros) + protocol.pack_floats(values))
+
+    def _send(self, kind: Kind, body: bytes) -> None:
+        """One frame to the host, through the faults; every frame takes a sequence number."""
+        wire = protocol.encode(kind, self._seq, body)
+        self._seq = (self._seq + 1) & 0xFFFF
+        if self._rng.random() < self.faults.drop:
+            return
+        if self._rng.random() < self.faults.corrupt:
+            damaged = bytearray(wire)
+            damaged[self._rng.integers(len(wire) - 1)] ^= 1 << int(self._rng.integers(8))
+            wire = bytes(damaged)
+        try:
+            os.write(self._master, wire)
+        except OSError:
+            self._stopped.set()  # the pty is gone

@@ -1,0 +1,134 @@
+"""The PneuNet rig of chapter 2: the device's program (for the emulator) and the host driver.
+
+The controller runs on the device, as on the book's Arduino: each PWM period it reads the flex
+sensor, evaluates the PID of the gains it was sent (Eqs. 2.2-2.4) against its reference
+program and writes the valve's 8-bit PWM count. Telemetry per sample: the reference [°], the
+sensor's angle [°] and the PWM count. The host sends gains, a reference program, and START
+with the run's length and the noise seed (an emulated rig draws its sensor noise from it; a
+real one ignores it).
+"""
+
+from __future__ import annotations
+
+import math
+import struct
+
+import numpy as np
+
+from articula.control.pid import PID, GainSchedule
+from articula.errors import ConfigError, DeviceError
+from articula.plants.pneunet import PneuNetBatch, PneuNetParams
+from articula.rigs.link import Link
+from articula.rigs.programs import Program, Shape
+from articula.rigs.protocol import (
+    PROTOCOL_VERSION,
+    Channel,
+    Info,
+    Kind,
+    RigKind,
+    pack_floats,
+    unpack_floats,
+)
+from articula.rigs.run import run_program
+from articula.tuning.response import Response
+
+FIRMWARE = (0, 1, 0)
+CHANNELS = (Channel("reference", "deg"), Channel("angle", "deg"), Channel("pwm", "counts"))
+SCHEDULES = ("constant", "piecewise", "fuzzy")
+
+
+def encode_gains(schedule: GainSchedule) -> bytes:
+    """SET_GAINS' body: schedule u8, rows u8, then per row K_p, K_i, K_d and its point (float32)."""
+    rows = schedule.gains.shape[0]
+    points = np.broadcast_to(schedule.points, (rows,))
+    table = np.column_stack([schedule.gains, points])
+    return struct.pack("<BB", SCHEDULES.index(schedule.kind), rows) + pack_floats(table.ravel())
+
+
+def decode_gains(body: bytes) -> GainSchedule:
+    """SET_GAINS' body as a GainSchedule; DeviceError when it does not decode."""
+    if len(body) < 2 or body[0] >= len(SCHEDULES) or len(body) != 2 + 16 * body[1]:
+        raise DeviceError("SET_GAINS does not decode")
+    table = unpack_floats(body, 4 * body[1], 2).reshape(body[1], 4)
+    try:
+        return GainSchedule(SCHEDULES[body[0]], table[:, :3], table[:, 3])
+    except ConfigError as exc:
+        raise DeviceError(f"SET_GAINS: {exc}") from None
+
+
+class PneuNetDevice:
+    """The rig's program, run by the emulator against the simulated actuator."""
+
+    def __init__(self, params: PneuNetParams | None = None) -> None:
+        self.params = params or PneuNetParams()
+        period_us = round(self.params.pwm_period * 1e6)
+        self.info = Info(RigKind.PNEUNET, PROTOCOL_VERSION, FIRMWARE, period_us, CHANNELS)
+        self.schedule = GainSchedule("constant", np.array([[1.0, 1.0, 0.0]]))
+        self.program = Program(Shape.CONSTANT, (0.0,))
+        self.output: float | None = None  # a PWM count held open-loop (SET_OUTPUT)
+        self._steps = 0
+
+    def configure(self, kind: int, body: bytes) -> None:
+        """Take SET_GAINS, SET_REFERENCE or SET_OUTPUT (channel 0: the PWM count)."""
+        if kind == Kind.SET_GAINS:
+            self.schedule = decode_gains(body)
+        elif kind == Kind.SET_REFERENCE:
+            self.program = Program.decode(body)
+        elif kind == Kind.SET_OUTPUT:
+            channel, value = struct.unpack("<Bf", body)
+            if channel != 0 or not 0.0 <= value <= 255.0:
+                raise DeviceError("SET_OUTPUT: channel 0 takes a PWM count in 0-255")
+            self.output = value
+        else:
+            raise DeviceError(f"the PneuNet rig does not take {Kind(kind).name}")
+
+    def start(self, duration: float, seed: int) -> None:
+        """A run of `duration` [s] from rest; sensor noise from seed as run_closed_loop draws
+        it (the first of SeedSequence(seed)'s two streams)."""
+        self._steps = round(duration / self.params.pwm_period)
+        noise_seed, _ = np.random.SeedSequence(seed).spawn(2)
+        self._noise = np.random.default_rng(noise_seed).standard_normal(self._steps)
+        self._plant = PneuNetBatch(self.params, 1, None)
+        self._pid = PID(self.schedule, (0.0, 255.0))
+        self._pid.reset(1)
+        self._n = 0
+
+    def sample(self) -> np.ndarray | None:
+        """One PWM period: (reference, angle, PWM count); None when the run is over."""
+        if self._n >= self._steps:
+            return None
+        t = self._n * self.params.pwm_period
+        measured = np.degrees(self._plant.read(self._noise[self._n : self._n + 1]))
+        reference = float(self.program.at(t))
+        if self.output is None:
+            count = math.floor(float(self._pid(t, reference, measured)[0]))
+        else:
+            count = math.floor(self.output)
+        self._plant.advance(np.array([count / 255.0]))
+        self._n += 1
+        return np.array([reference, measured[0], count])
+
+    def stop(self) -> None:
+        """End the run: the valve closed."""
+        self._steps = self._n
+        self.output = None
+
+
+class PneuNetRig:
+    """The tuner's view of a PneuNet rig: run one experiment with gains K over the line and
+    return its response, as loops.pneunet_pid.SimulatedRig does in process."""
+
+    def __init__(self, link: Link, program: Program, duration: float, seed: int) -> None:
+        if link.info.rig != RigKind.PNEUNET:
+            raise DeviceError(f"{link.port}: a {link.info.rig.name.lower()} rig, not a PneuNet")
+        self.link, self.program, self.duration, self.seed = link, program, duration, seed
+        self.calls = 0
+
+    def __call__(self, gains: np.ndarray) -> Response:
+        """One experiment from rest with constant gains [K_p, K_i, K_d]."""
+        schedule = GainSchedule("constant", np.asarray(gains, dtype=float)[None, :])
+        self.link.command(Kind.SET_GAINS, encode_gains(schedule))
+        self.link.command(Kind.SET_REFERENCE, self.program.encode())
+        t, values = run_program(self.link, self.duration, self.seed + self.calls)
+        self.calls += 1
+        return Response(t, values[:, 0], values[:, 1])

@@ -1,0 +1,207 @@
+"""The rigs' serial protocol (docs/protocol.md): COBS-framed binary messages with a CRC-16.
+
+On the wire a frame is COBS(header + body + CRC) followed by a zero byte. The header is the
+message type (one byte) and the sender's sequence number (u16, little-endian, wrapping); the
+CRC is CRC-16/CCITT-FALSE of header and body, little-endian. Numbers are little-endian;
+reals are IEEE-754 float32, as the ATmega2560's avr-gcc stores them. COBS leaves no zero byte
+inside a frame, so a receiver that lost its place resynchronises at the next zero.
+"""
+
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass
+from enum import IntEnum
+
+import numpy as np
+
+from articula.errors import DeviceError
+
+PROTOCOL_VERSION = 1
+MAX_FRAME = 254  # bytes of header + body + CRC: one COBS block, a zero-free 255-byte frame
+HEADER = struct.Struct("<BH")  # type, sequence number
+CRC = struct.Struct("<H")
+
+
+class Kind(IntEnum):
+    """Message types: host commands below 0x80, device messages from 0x80."""
+
+    HELLO = 0x01  # () -> INFO
+    SET_GAINS = 0x02  # schedule, gains rows and breakpoints (encode_gains)
+    SET_REFERENCE = 0x03  # a reference program (encode_reference)
+    START = 0x04  # duration [s] float32, noise seed u32: a run from rest; DONE at its end
+    STOP = 0x05  # () ends a run now (actuators off)
+    SET_OUTPUT = 0x06  # channel u8, value float32: one actuator command held until STOP
+    SET_DAMPING = 0x07  # delta, start [s], length [s] float32: the chapter-3 policy
+    STREAM = 0x08  # decimation u16: one TELEMETRY frame every that many samples (0: none)
+    STATUS = 0x09  # () -> ACK with running u8 and the run's samples so far u32 after the seq
+    INFO = 0x81  # the handshake (encode_info); also sent unasked after a reset
+    ACK = 0x82  # acknowledged sequence number u16
+    ERROR = 0x83  # sequence number u16, code u8, text (ASCII)
+    TELEMETRY = 0x84  # device time [µs] u32, then one float32 per channel of INFO
+    DONE = 0x85  # sequence number of the START u16, samples taken u32
+
+
+class ErrorCode(IntEnum):
+    """Codes of ERROR replies."""
+
+    BAD_FRAME = 1  # a command that does not decode (its body has the wrong length)
+    UNKNOWN = 2  # a message type this rig does not take
+    BAD_VALUE = 3  # a value out of the rig's range
+    BUSY = 4  # a command that needs the rig at rest, during a run
+
+
+class RigKind(IntEnum):
+    """The three rigs of chapters 2-4."""
+
+    PNEUNET = 1
+    SIX_CHAMBER = 2
+    MOTOR = 3
+
+
+@dataclass(frozen=True)
+class Frame:
+    """One decoded message: its type, the sender's sequence number and its body."""
+
+    kind: int
+    seq: int
+    body: bytes
+
+
+@dataclass(frozen=True)
+class Channel:
+    """A telemetry channel: name and unit (SI or counts)."""
+
+    name: str
+    unit: str
+
+
+@dataclass(frozen=True)
+class Info:
+    """The handshake: what is on the other end of the line."""
+
+    rig: RigKind
+    protocol: int
+    firmware: tuple[int, int, int]
+    sample_period_us: int
+    channels: tuple[Channel, ...]
+
+
+def crc16(data: bytes) -> int:
+    """CRC-16/CCITT-FALSE (polynomial 0x1021, initial 0xFFFF): 0x29B1 for b"123456789"."""
+    crc = 0xFFFF
+    for byte in data:
+        crc ^= byte << 8
+        for _ in range(8):
+            crc = ((crc << 1) ^ 0x1021) & 0xFFFF if crc & 0x8000 else (crc << 1) & 0xFFFF
+    return crc
+
+
+def cobs_encode(data: bytes) -> bytes:
+    """Consistent Overhead Byte Stuffing of `data` (at most 254 bytes: one block)."""
+    out = bytearray([0])
+    code_at, code = 0, 1
+    for byte in data:
+        if byte == 0:
+            out[code_at] = code
+            code_at, code = len(out), 1
+            out.append(0)
+        else:
+            out.append(byte)
+            code += 1
+    out[code_at] = code
+    return bytes(out)
+
+
+def cobs_decode(data: bytes) -> bytes:
+    """The bytes `cobs_encode` was given; DeviceError for a malformed block."""
+    out = bytearray()
+    i = 0
+    while i < len(data):
+        code = data[i]
+        if code == 0 or i + code > len(data):
+            raise DeviceError("malformed COBS block")
+        out += data[i + 1 : i + code]
+        i += code
+        if code < 0xFF and i < len(data):
+            out.append(0)
+    return bytes(out)
+
+
+def encode(kind: int, seq: int, body: bytes = b"") -> bytes:
+    """The wire bytes of one message, delimiter included."""
+    payload = HEADER.pack(kind, seq & 0xFFFF) + body
+    payload += CRC.pack(crc16(payload))
+    if len(payload) > MAX_FRAME:
+        raise DeviceError(f"a frame of {len(payload)} bytes exceeds {MAX_FRAME}")
+    return cobs_encode(payload) + b"\0"
+
+
+def decode(frame: bytes) -> Frame:
+    """One message from the bytes between two delimiters; DeviceError when it is damaged."""
+    payload = cobs_decode(frame)
+    if len(payload) < HEADER.size + CRC.size:
+        raise DeviceError(f"a frame of {len(payload)} bytes is too short")
+    (crc,) = CRC.unpack_from(payload, len(payload) - CRC.size)
+    if crc16(payload[: -CRC.size]) != crc:
+        raise DeviceError("CRC mismatch")
+    kind, seq = HEADER.unpack_from(payload)
+    return Frame(kind, seq, payload[HEADER.size : -CRC.size])
+
+
+class Deframer:
+    """Splits a byte stream into frames at the zero delimiters, across reads."""
+
+    def __init__(self) -> None:
+        self._pending = bytearray()
+
+    def feed(self, data: bytes) -> list[bytes]:
+        """The complete frames (delimiters removed, empty ones skipped) that `data` ends."""
+        self._pending += data
+        *frames, rest = bytes(self._pending).split(b"\0")
+        self._pending = bytearray(rest[-2 * MAX_FRAME :])  # garbage cannot grow without bound
+        return [f for f in frames if f]
+
+
+def pack_floats(values: np.ndarray | list[float]) -> bytes:
+    """Values as little-endian float32."""
+    return np.asarray(values, dtype="<f4").tobytes()
+
+
+def unpack_floats(body: bytes, count: int, offset: int = 0) -> np.ndarray:
+    """`count` little-endian float32 from body[offset:] as float64; DeviceError if short."""
+    if len(body) < offset + 4 * count:
+        raise DeviceError(f"expected {count} reals, the body holds {(len(body) - offset) // 4}")
+    return np.frombuffer(body, dtype="<f4", count=count, offset=offset).astype(float)
+
+
+def encode_info(info: Info) -> bytes:
+    """The body of INFO."""
+    out = struct.pack("<BBBBBIB", info.protocol, info.rig, *info.firmware,
+                      info.sample_period_us, len(info.channels))  # fmt: skip
+    for channel in info.channels:
+        for text in (channel.name, channel.unit):
+            data = text.encode("ascii")
+            out += struct.pack("<B", len(data)) + data
+    return out
+
+
+def decode_info(body: bytes) -> Info:
+    """INFO's body as an Info; DeviceError when it does not decode."""
+    try:
+        protocol, rig, major, minor, patch, period, count = struct.unpack_from("<BBBBBIB", body)
+        at, channels = struct.calcsize("<BBBBBIB"), []
+        for _ in range(count):
+            texts = []
+            for _ in range(2):
+                size = body[at]
+                if at + 1 + size > len(body):
+                    raise ValueError("a channel's text runs past the end")
+                texts.append(body[at + 1 : at + 1 + size].decode("ascii"))
+                at += 1 + size
+            channels.append(Channel(*texts))
+        if at != len(body):
+            raise ValueError(f"{len(body) - at} bytes after the last channel")
+        return Info(RigKind(rig), protocol, (major, minor, patch), period, tuple(channels))
+    except (struct.error, IndexError, ValueError, UnicodeDecodeError) as exc:
+        raise DeviceError(f"the handshake does not decode ({exc})") from None

@@ -1,0 +1,36 @@
+"""One run on a rig: start it, take its telemetry until it says it is done."""
+
+from __future__ import annotations
+
+import struct
+
+import numpy as np
+
+from articula.rigs.link import Link
+from articula.rigs.protocol import Kind, unpack_floats
+
+QUIET = 0.3  # [s] without a frame during a run before the host asks the rig for its status
+
+
+def run_program(link: Link, duration: float, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """Run the rig's loaded program for `duration` [s] (noise seed for an emulated rig);
+    returns the sample times [s, device clock from the run's start] and the telemetry rows
+    (one per sample received, one column per channel of the handshake)."""
+    channels = len(link.info.channels)
+    link.command(Kind.STREAM, struct.pack("<H", 1))
+    start = link.command(Kind.START, struct.pack("<fI", duration, seed & 0xFFFFFFFF))
+    times, rows = [], []
+    while True:
+        frame = link.next_frame(QUIET)
+        if frame is None:  # DONE lost on the way, or the rig stalled: ask it
+            running, _ = link.status()
+            if not running:
+                break
+            continue
+        if frame.kind == Kind.TELEMETRY:
+            (micros,) = struct.unpack_from("<I", frame.body)
+            times.append(micros * 1e-6)
+            rows.append(unpack_floats(frame.body, channels, 4))
+        elif frame.kind == Kind.DONE and int.from_bytes(frame.body[:2], "little") == start:
+            break
+    return np.array(times), np.array(rows).reshape(-1, channels)
