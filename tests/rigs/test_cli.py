@@ -6,23 +6,90 @@ from __future__ import annotations
 import json
 import signal
 import subprocess
+import time
 
+import pyarrow.parquet as pq
 import pytest
 
 from tests.conftest import ARTICULA
+
+PID_CONFIG = """
+experiment = "pneunet.pid"
+seed = 3
+trials = 2
+duration = 4.0
+[reference]
+kind = "sinusoid"
+offset_deg = 45.0
+amplitude_deg = 30.0
+frequency = 0.25
+[controller]
+gains = [[2.0, 1.5, 0.05]]
+"""
+
+
+def emulate(*options: str) -> tuple[subprocess.Popen, str]:
+    """`articula emulate pneunet <options>` started; (its process, its device path)."""
+    proc = subprocess.Popen([ARTICULA, "emulate", "pneunet", *options], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)  # fmt: skip
+    line = proc.stdout.readline()
+    assert "pneunet rig at /dev/" in line, proc.stderr.read()
+    return proc, line.split(" at ")[1].split()[0]
 
 
 @pytest.fixture
 def emulated_pneunet():
     """`articula emulate pneunet --fast` running; its device path."""
-    proc = subprocess.Popen([ARTICULA, "emulate", "pneunet", "--fast"], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)  # fmt: skip
-    line = proc.stdout.readline()
-    assert "pneunet rig at /dev/" in line, proc.stderr.read()
-    yield line.split(" at ")[1].split()[0]
+    proc, path = emulate("--fast")
+    yield path
     proc.send_signal(signal.SIGINT)
     assert proc.wait(10) == 0
     assert proc.stderr.read() == ""
+
+
+@pytest.fixture
+def pid_config(tmp_path):
+    """A short chapter-2 PID config (two trials of 4 s on a sinusoid)."""
+    path = tmp_path / "pid.toml"
+    path.write_text(PID_CONFIG)
+    return path
+
+
+def test_rig_run_writes_a_run_folder_with_the_lines_losses(emulated_pneunet, pid_config, cli,
+                                                          tmp_path):  # fmt: skip
+    proc = cli("rig", "run", emulated_pneunet, pid_config, "--out", tmp_path / "run", "--json")
+    assert proc.returncode == 0, proc.stderr
+    record = json.loads(proc.stdout)
+    assert record["complete"] and record["samples"] == 2 * 120
+    assert record["link"]["crc_errors"] == record["link"]["dropped"] == 0
+    assert 0 < record["metrics"]["error_median_deg"] < 45
+    trace = pq.read_table(tmp_path / "run" / "trace.parquet").to_pydict()
+    assert set(trace) == {"t", "trial", "theta_ref_deg", "theta_meas_deg", "pwm"}
+    journal = (tmp_path / "run" / "telemetry.csv").read_text().splitlines()
+    assert len(journal) == 1 + 240  # a header, then every sample as it came
+
+
+@pytest.mark.parametrize("ending", ["reset", "unplug"])
+def test_a_run_cut_short_keeps_what_came_and_says_why(pid_config, tmp_path, ending):
+    options = ["--realtime", "--faults", "reset_at=1.0"] if ending == "reset" else ["--realtime"]
+    emulator, path = emulate(*options)
+    try:
+        run = subprocess.Popen([ARTICULA, "rig", "run", path, pid_config, "--out",
+                                tmp_path / "run"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)  # fmt: skip
+        if ending == "unplug":
+            time.sleep(1.5)
+            emulator.kill()
+        assert run.wait(30) == 1
+        error = run.stderr.read().strip().splitlines()
+        assert len(error) == 1
+        assert ("restarted" if ending == "reset" else "went down") in error[0]
+    finally:
+        emulator.kill()
+    record = json.loads((tmp_path / "run" / "record.json").read_text())
+    assert not record["complete"] and record["incomplete"] in error[0]
+    rows = pq.read_table(tmp_path / "run" / "trace.parquet").num_rows
+    assert 10 < rows == record["samples"] < 240
 
 
 def test_rig_info_of_an_emulated_pneunet(emulated_pneunet, cli):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import struct
+from collections.abc import Callable
 
 import numpy as np
 
@@ -12,10 +13,16 @@ from articula.rigs.protocol import Kind, unpack_floats
 QUIET = 0.3  # [s] without a frame during a run before the host asks the rig for its status
 
 
-def run_program(link: Link, duration: float, seed: int) -> tuple[np.ndarray, np.ndarray]:
+def run_program(
+    link: Link,
+    duration: float,
+    seed: int,
+    on_sample: Callable[[float, np.ndarray], None] | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """Run the rig's loaded program for `duration` [s] (noise seed for an emulated rig);
     returns the sample times [s, device clock from the run's start] and the telemetry rows
-    (one per sample received, one column per channel of the handshake)."""
+    (one per sample received, one column per channel of the handshake). `on_sample(t, row)`
+    sees each sample as it arrives (a Recorder's add)."""
     channels = len(link.info.channels)
     link.command(Kind.STREAM, struct.pack("<H", 1))
     start = link.command(Kind.START, struct.pack("<fI", duration, seed & 0xFFFFFFFF))
@@ -31,6 +38,8 @@ def run_program(link: Link, duration: float, seed: int) -> tuple[np.ndarray, np.
             (micros,) = struct.unpack_from("<I", frame.body)
             times.append(micros * 1e-6)
             rows.append(unpack_floats(frame.body, channels, 4))
+            if on_sample is not None:
+                on_sample(times[-1], rows[-1])
         elif frame.kind == Kind.DONE and int.from_bytes(frame.body[:2], "little") == start:
             break
     return np.array(times), np.array(rows).reshape(-1, channels)

@@ -30,7 +30,9 @@ RESULTS = "results.parquet"
 REPORT = "report.md"
 SUMMARY = "summary.json"
 SUITE_FILES = frozenset({RESULTS, SUMMARY})  # and the problems/ folder
-RUN_FILES = frozenset({CONFIG, RECORD, TRACE})
+JOURNAL = "telemetry.csv"  # a rig run's samples as they arrived (rigs/recorder.py)
+TUNING = "tuning.json"  # a rig tuning's result (articula rig tune)
+RUN_FILES = frozenset({CONFIG, RECORD, TRACE, JOURNAL, TUNING})
 RUN_FOLDER = re.compile(r"^[0-9a-f]{12}$")  # a sweep's run folder: the config's hash
 # What atomic_write leaves when killed mid-write: .<name>.<8 random characters>.tmp
 TEMPORARY = re.compile(r"^\.(?P<name>.+)\.[A-Za-z0-9_]{8}\.tmp$")
