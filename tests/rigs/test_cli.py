@@ -11,6 +11,7 @@ import time
 import pyarrow.parquet as pq
 import pytest
 
+from articula.book.ch2.tuning import AutoConfig, TuningConfig, auto_run
 from tests.conftest import ARTICULA
 
 PID_CONFIG = """
@@ -115,3 +116,26 @@ def test_bad_ports_and_options_are_one_line_and_exit_2(cli, args, words):
     proc = cli(*args)
     assert proc.returncode == 2
     assert len(proc.stderr.strip().splitlines()) == 1 and words in proc.stderr
+
+
+def test_rig_tune_reaches_the_in_process_gains(emulated_pneunet, cli, tmp_path):
+    config = tmp_path / "tuning.toml"
+    config.write_text("[auto]\nseed = 2000\nhold = 2.0\nmax_iterations = 5\n")
+    proc = cli("rig", "tune", emulated_pneunet, "--config", config, "--levels", "30,60",
+               "--out", tmp_path / "tune", "--json")  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    result = json.loads(proc.stdout)
+    tuning = TuningConfig(auto=AutoConfig(seed=2000, hold=2.0, max_iterations=5))
+    here = auto_run(tuning, (30.0, 60.0), 0).result
+    assert result["experiments"] == here.evaluations
+    assert result["gains"] == pytest.approx(here.k.tolist(), rel=1e-4)
+    assert json.loads((tmp_path / "tune" / "tuning.json").read_text()) == result
+
+
+def test_rig_record_takes_every_channel(emulated_pneunet, cli, tmp_path):
+    proc = cli("rig", "record", emulated_pneunet, "--duration", "2", "--out", tmp_path / "rec",
+               "--json")  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert json.loads(proc.stdout)["samples"] == 60  # 2 s at 30 Hz
+    trace = pq.read_table(tmp_path / "rec" / "trace.parquet").to_pydict()
+    assert list(trace) == ["t", "reference", "angle", "pwm"]

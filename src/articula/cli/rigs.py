@@ -2,13 +2,23 @@
 
 from __future__ import annotations
 
+import dataclasses
 import threading
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
-from articula.cli.app import Force, JsonFlag, OutDir, app, emit_json, out, print_table
+from articula.cli.app import (
+    Force,
+    JsonFlag,
+    OutDir,
+    app,
+    emit_json,
+    out,
+    print_table,
+    progress_bar,
+)
 
 rig_app = typer.Typer(no_args_is_help=True, help="A bench rig on a serial port.")
 app.add_typer(rig_app, name="rig")
@@ -126,3 +136,107 @@ def run_(
     lost = record["link"]
     out.print(f"{record['samples']} samples; line: {lost['crc_errors']} damaged, "
               f"{lost['dropped']} lost, {lost['resends']} resent; in {out_dir}")  # fmt: skip
+
+
+@rig_app.command()
+def record(
+    port: Port,
+    duration: Annotated[float, typer.Option(min=0.001, help="Seconds to record [s].")],
+    out_dir: OutDir,
+    seed: Annotated[int, typer.Option(min=0, help="Noise seed of an emulated rig.")] = 0,
+    force: Force = False,
+    as_json: JsonFlag = False,
+) -> None:
+    """Run the rig with what it holds (gains, reference) and record every channel.
+
+    Example: articula rig record /dev/ttyACM0 --duration 10 --out runs/record"""
+    from articula.rigs.link import Link
+    from articula.rigs.recorder import Recorder
+    from articula.rigs.run import run_program
+    from articula.runs.folders import claimed
+
+    with claimed(out_dir, "run", force), Link(port) as link:
+        channels = [c.name for c in link.info.channels]
+        config = {"experiment": "rig.record", "port": port, "duration": duration, "seed": seed,
+                  "rig": link.info.rig.name.lower()}  # fmt: skip
+        recorder = Recorder(out_dir, config, channels)
+        try:
+            run_program(link, duration, seed, recorder.add)
+        except BaseException as exc:  # whatever stops the run, what was received is kept
+            why = "interrupted (Ctrl-C)" if isinstance(exc, KeyboardInterrupt) else str(exc)
+            recorder.finish({}, link.stats, incomplete=why)
+            raise
+        summary = recorder.finish({}, link.stats)
+    if as_json:
+        emit_json(summary)
+        return
+    out.print(f"{summary['samples']} samples of {', '.join(channels)} in {out_dir}")
+
+
+@rig_app.command()
+def tune(
+    port: Port,
+    out_dir: OutDir,
+    config: Annotated[
+        Path | None,
+        typer.Option(
+            help="A chapter-2 tuning config ([auto] table; default: the book's quick one)."
+        ),
+    ] = None,
+    levels: Annotated[str, typer.Option(help="Reference levels [deg], comma-separated.")] = "30,60",
+    index: Annotated[int, typer.Option(min=0, help="Which run of the config's seeds.")] = 0,
+    force: Force = False,
+    as_json: JsonFlag = False,
+) -> None:
+    """Tune the PneuNet rig's PID by coordinate descent (chapter 2, Algorithm 1), one
+    experiment on the rig per probe; writes tuning.json.
+
+    Example: articula rig tune /dev/ttyACM0 --levels 30,60 --out runs/tuning"""
+    import json
+
+    import numpy as np
+
+    from articula.book.ch2.tuning import TuningConfig, auto_run, auto_seed
+    from articula.book.study import packaged
+    from articula.errors import ConfigError
+    from articula.rigs.link import Link
+    from articula.rigs.pneunet import PneuNetRig
+    from articula.rigs.programs import steps
+    from articula.rigs.protocol import RigKind
+    from articula.runs.folders import TUNING, claimed
+    from articula.runs.records import atomic_write
+    from articula.tuning.response import Response
+    from articula.validation import load_toml, parse_model
+
+    try:
+        chosen = tuple(float(v) for v in levels.split(","))
+    except ValueError:
+        raise ConfigError(
+            "--levels", f"comma-separated angles in degrees (got {levels!r})"
+        ) from None
+    data = load_toml(config or packaged("ch2", "tuning_quick.toml"))
+    tuning = parse_model(TuningConfig, data, str(config or "tuning_quick.toml"))
+    a = tuning.auto
+    with claimed(out_dir, "run", force), Link(port, RigKind.PNEUNET) as link:
+        rig = PneuNetRig(
+            link, steps(chosen, a.hold), len(chosen) * a.hold, auto_seed(tuning, index)
+        )
+        with progress_bar(as_json) as bar:
+            task = bar.add_task("experiments on the rig", total=None)
+
+            def probe(k: np.ndarray) -> Response:
+                bar.advance(task)
+                return rig(k)
+
+            run = auto_run(tuning, chosen, index, rig=probe)
+        result = {"levels_deg": list(chosen), "gains": run.result.k.tolist(),
+                  "cost": run.result.cost, "experiments": run.result.evaluations,
+                  "sweeps": len(run.result.history) - 1,
+                  "link": dataclasses.asdict(link.stats)}  # fmt: skip
+        atomic_write(out_dir / TUNING, json.dumps(result, indent=2).encode())
+    if as_json:
+        emit_json(result)
+        return
+    kp, ki, kd = result["gains"]
+    out.print(f"K_p = {kp:.4g}, K_i = {ki:.4g}, K_d = {kd:.4g}: M = {result['cost']:.4g} "
+              f"after {result['experiments']} experiments; in {out_dir / TUNING}")  # fmt: skip
