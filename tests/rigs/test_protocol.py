@@ -31,6 +31,21 @@ def test_crc16_ccitt_false_check_value():
     assert crc16(b"123456789") == 0x29B1  # the catalogue's check value of CRC-16/CCITT-FALSE
 
 
+def bitwise_crc16(data: bytes) -> int:
+    """CRC-16/CCITT-FALSE bit by bit, as the firmware computes it."""
+    crc = 0xFFFF
+    for byte in data:
+        crc ^= byte << 8
+        for _ in range(8):
+            crc = ((crc << 1) ^ 0x1021) & 0xFFFF if crc & 0x8000 else (crc << 1) & 0xFFFF
+    return crc
+
+
+@given(st.binary(max_size=300))
+def test_crc16_is_the_bitwise_crc(data):
+    assert crc16(data) == bitwise_crc16(data)
+
+
 @pytest.mark.parametrize(
     ("raw", "stuffed"),
     [
