@@ -22,13 +22,13 @@ from articula.cli.app import (
 
 rig_app = typer.Typer(no_args_is_help=True, help="A bench rig on a serial port.")
 app.add_typer(rig_app, name="rig")
-RIGS = ("pneunet",)  # the rigs an emulator exists for (six-chamber and motor: next)
+RIGS = ("pneunet", "six-chamber")  # the rigs an emulator exists for (motor: next)
 Port = Annotated[str, typer.Argument(help="The rig's serial port, e.g. /dev/ttyACM0.")]
 
 
 @app.command()
 def emulate(
-    rig: Annotated[str, typer.Argument(help="pneunet.")],
+    rig: Annotated[str, typer.Argument(help="pneunet or six-chamber.")],
     realtime: Annotated[
         bool,
         typer.Option(
@@ -47,10 +47,12 @@ def emulate(
     from articula.errors import ConfigError
     from articula.rigs.emulator import Emulator, Faults
     from articula.rigs.pneunet import PneuNetDevice
+    from articula.rigs.six_chamber import SixChamberDevice
 
     if rig not in RIGS:
         raise ConfigError("RIG", f"no emulator for {rig!r}; choose one of {', '.join(RIGS)}")
-    emulator = Emulator(PneuNetDevice(), realtime, Faults.parse(faults), seed).start()
+    device = PneuNetDevice() if rig == "pneunet" else SixChamberDevice()
+    emulator = Emulator(device, realtime, Faults.parse(faults), seed).start()
     out.print(f"{rig} rig at {emulator.path} (Ctrl-C stops it)")
     try:
         threading.Event().wait()
@@ -88,7 +90,10 @@ def info(port: Port, as_json: JsonFlag = False) -> None:
         out.print(escape(f"  {c.name} [{c.unit}]"))
 
 
-RIG_RUNS = {"pneunet.pid": ("articula.book.ch2.rig", "PNEUNET")}  # experiment -> driver, rig
+RIG_RUNS = {  # experiment -> (its driver, the rig it needs)
+    "pneunet.pid": ("articula.book.ch2.rig", "PNEUNET"),
+    "softarm.damping": ("articula.book.ch3.rig", "SIX_CHAMBER"),
+}
 
 
 @rig_app.command("run")

@@ -3,7 +3,8 @@ control period (SET_REFERENCE, docs/protocol.md).
 
 constant: (value,); steps: (hold [s], level, level, ...) each level held `hold` seconds, the
 last one to the end; sinusoid: (offset, amplitude, frequency [Hz]): offset − amplitude ·
-cos(2π f t), which starts at rest, as chapter 2's reference does.
+cos(2π f t), which starts at rest, as chapter 2's reference does; actuation (the six-chamber
+rig's): (side [deg], gauge pressure [Pa], hold [s]): fill that side, hold, vent at `hold`.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ class Shape(IntEnum):
     CONSTANT = 0
     STEPS = 1
     SINUSOID = 2
+    ACTUATION = 3
 
 
 MAX_VALUES = (MAX_FRAME - 3 - 2 - 2) // 4  # header, CRC, shape and count bytes
@@ -38,7 +40,7 @@ class Program:
     values: tuple[float, ...]
 
     def __post_init__(self) -> None:
-        need = {Shape.CONSTANT: 1, Shape.SINUSOID: 3}.get(self.shape)
+        need = {Shape.CONSTANT: 1, Shape.SINUSOID: 3, Shape.ACTUATION: 3}.get(self.shape)
         if need is not None and len(self.values) != need:
             raise ConfigError("program", f"a {self.shape.name.lower()} takes {need} numbers")
         if self.shape == Shape.STEPS and not 2 <= len(self.values) <= MAX_VALUES:
@@ -52,6 +54,8 @@ class Program:
         """The reference at times t [s]."""
         t = np.asarray(t, dtype=float)
         v = self.values
+        if self.shape == Shape.ACTUATION:
+            raise ConfigError("program", "an actuation has no reference value over time")
         if self.shape == Shape.CONSTANT:
             return np.full(t.shape, v[0])
         if self.shape == Shape.SINUSOID:
