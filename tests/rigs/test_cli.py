@@ -12,6 +12,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from articula.book.ch2.tuning import AutoConfig, TuningConfig, auto_run
+from articula.book.study import packaged
 from tests.conftest import ARTICULA
 
 PID_CONFIG = """
@@ -108,7 +109,8 @@ def test_rig_info_of_an_emulated_pneunet(emulated_pneunet, cli):
     [
         (["rig", "info", "/dev/no-such-rig"], "cannot open the port"),
         (["rig", "info", "/dev/null"], "cannot open the port"),
-        (["emulate", "motor"], "no emulator for 'motor'"),
+        (["emulate", "wobble"], "no emulator for 'wobble'"),
+        (["emulate", "pneunet", "--plant", "x.toml"], "only the motor rig"),
         (["emulate", "pneunet", "--faults", "drop=3"], "probability"),
     ],
 )
@@ -139,3 +141,22 @@ def test_rig_record_takes_every_channel(emulated_pneunet, cli, tmp_path):
     assert json.loads(proc.stdout)["samples"] == 60  # 2 s at 30 Hz
     trace = pq.read_table(tmp_path / "rec" / "trace.parquet").to_pydict()
     assert list(trace) == ["t", "reference", "angle", "pwm"]
+
+
+def test_rig_run_of_fig_4_6_on_the_emulated_motor_rig_is_articula_run(cli, tmp_path):
+    config = packaged("ch4", "fig4_6.toml")
+    proc = subprocess.Popen([ARTICULA, "emulate", "motor", "--plant", str(config)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+    try:
+        path = proc.stdout.readline().split(" at ")[1].split()[0]
+        on_rig = cli("rig", "run", path, config, "--out", tmp_path / "rig", "--json")
+    finally:
+        proc.send_signal(signal.SIGINT)
+        proc.wait(10)
+    assert on_rig.returncode == 0, on_rig.stderr
+    here = json.loads(cli("run", config, "--out", tmp_path / "here", "--json").stdout)
+    rig = json.loads(on_rig.stdout)
+    assert rig["samples"] == 6000
+    for key, value in here["metrics"].items():  # null: a metric this run has not (NaN)
+        expected = None if value is None else pytest.approx(value, rel=1e-5, abs=1e-6)
+        assert rig["metrics"][key] == expected, key

@@ -22,13 +22,13 @@ from articula.cli.app import (
 
 rig_app = typer.Typer(no_args_is_help=True, help="A bench rig on a serial port.")
 app.add_typer(rig_app, name="rig")
-RIGS = ("pneunet", "six-chamber")  # the rigs an emulator exists for (motor: next)
+RIGS = ("pneunet", "six-chamber", "motor")
 Port = Annotated[str, typer.Argument(help="The rig's serial port, e.g. /dev/ttyACM0.")]
 
 
 @app.command()
 def emulate(
-    rig: Annotated[str, typer.Argument(help="pneunet or six-chamber.")],
+    rig: Annotated[str, typer.Argument(help="pneunet, six-chamber or motor.")],
     realtime: Annotated[
         bool,
         typer.Option(
@@ -40,6 +40,13 @@ def emulate(
         str, typer.Option(help="e.g. drop=0.01,corrupt=0.01,delay_ms=20,reset_at=5.0")
     ] = "",
     seed: Annotated[int, typer.Option(min=0, help="Seed of the faults' draws.")] = 0,
+    plant: Annotated[
+        Path | None,
+        typer.Option(
+            help="motor: a motor.current config whose rig, motor, dt, PWM, sensor and "
+            "encoder the emulated rig has (default: chapter 4's)."
+        ),
+    ] = None,
 ) -> None:
     """Start a simulated rig behind a pseudo-terminal and print its device path.
 
@@ -51,7 +58,19 @@ def emulate(
 
     if rig not in RIGS:
         raise ConfigError("RIG", f"no emulator for {rig!r}; choose one of {', '.join(RIGS)}")
-    device = PneuNetDevice() if rig == "pneunet" else SixChamberDevice()
+    if rig == "motor":
+        from articula.book.ch4.experiment import CurrentControlConfig
+        from articula.book.ch4.rig import emulated_motor
+        from articula.validation import load_toml, parse_model
+
+        data = {} if plant is None else load_toml(plant)
+        data.pop("experiment", None)
+        config = parse_model(CurrentControlConfig, data, str(plant or "defaults"))
+        device = emulated_motor(config)
+    elif plant is not None:
+        raise ConfigError("--plant", "only the motor rig takes a plant config")
+    else:
+        device = PneuNetDevice() if rig == "pneunet" else SixChamberDevice()
     emulator = Emulator(device, realtime, Faults.parse(faults), seed).start()
     out.print(f"{rig} rig at {emulator.path} (Ctrl-C stops it)")
     try:
@@ -93,6 +112,7 @@ def info(port: Port, as_json: JsonFlag = False) -> None:
 RIG_RUNS = {  # experiment -> (its driver, the rig it needs)
     "pneunet.pid": ("articula.book.ch2.rig", "PNEUNET"),
     "softarm.damping": ("articula.book.ch3.rig", "SIX_CHAMBER"),
+    "motor.current": ("articula.book.ch4.rig", "MOTOR"),
 }
 
 

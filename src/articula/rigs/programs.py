@@ -4,7 +4,9 @@ control period (SET_REFERENCE, docs/protocol.md).
 constant: (value,); steps: (hold [s], level, level, ...) each level held `hold` seconds, the
 last one to the end; sinusoid: (offset, amplitude, frequency [Hz]): offset − amplitude ·
 cos(2π f t), which starts at rest, as chapter 2's reference does; actuation (the six-chamber
-rig's): (side [deg], gauge pressure [Pa], hold [s]): fill that side, hold, vent at `hold`.
+rig's): (side [deg], gauge pressure [Pa], hold [s]): fill that side, hold, vent at `hold`;
+current (the motor rig's): (current [A], amplitude [A], frequency [rad/s], speed [rad/s]):
+i_ref = current + amplitude · sin(frequency · t), the load motor holding the speed.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ class Shape(IntEnum):
     STEPS = 1
     SINUSOID = 2
     ACTUATION = 3
+    CURRENT = 4
 
 
 MAX_VALUES = (MAX_FRAME - 3 - 2 - 2) // 4  # header, CRC, shape and count bytes
@@ -40,7 +43,8 @@ class Program:
     values: tuple[float, ...]
 
     def __post_init__(self) -> None:
-        need = {Shape.CONSTANT: 1, Shape.SINUSOID: 3, Shape.ACTUATION: 3}.get(self.shape)
+        need = {Shape.CONSTANT: 1, Shape.SINUSOID: 3, Shape.ACTUATION: 3,
+                Shape.CURRENT: 4}.get(self.shape)  # fmt: skip
         if need is not None and len(self.values) != need:
             raise ConfigError("program", f"a {self.shape.name.lower()} takes {need} numbers")
         if self.shape == Shape.STEPS and not 2 <= len(self.values) <= MAX_VALUES:
@@ -56,6 +60,8 @@ class Program:
         v = self.values
         if self.shape == Shape.ACTUATION:
             raise ConfigError("program", "an actuation has no reference value over time")
+        if self.shape == Shape.CURRENT:
+            return v[0] + v[1] * np.sin(v[2] * t)
         if self.shape == Shape.CONSTANT:
             return np.full(t.shape, v[0])
         if self.shape == Shape.SINUSOID:

@@ -1,0 +1,103 @@
+"""Chapter 4's current-control experiment on the dual-motor rig over serial (`articula rig
+run`), and the simulated rig `articula emulate motor` puts behind a pseudo-terminal.
+
+The rig closes its loops itself (rigs/motor.py); the host sends the config's gains and
+reference, records every control period and takes chapter 4's metrics on the trace: the
+same running sums `loops.motor_current` keeps, so an emulated rig gives the in-process
+numbers up to float32 on the line. The metrics are taken on the plant's true current where
+the rig sends it (an emulated rig); a real rig has only its sensor's (i_meas).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from articula.book.ch4.experiment import (
+    CurrentControlConfig,
+    CurrentReference,
+    metric_window,
+    metrics_from_sums,
+    simulate_batch,
+)
+from articula.control.moving_average import moving_average
+from articula.control.pwm import pwm_voltage
+from articula.rigs.link import Link
+from articula.rigs.motor import EMULATED, MEASURED, MotorDevice, MotorGains
+from articula.rigs.programs import Program, Shape
+from articula.rigs.protocol import Kind
+from articula.rigs.recorder import Recorder
+from articula.rigs.run import run_program
+
+CHANNELS = tuple(c.name for c in MEASURED + EMULATED)
+
+
+def emulated_motor(config: CurrentControlConfig) -> MotorDevice:
+    """A motor rig whose plant is `config`'s (motor, rig, dt, PWM, sensor, encoder); the
+    gains, reference, duration and seed are what the host sends."""
+
+    def plant(gains: MotorGains, reference: Program, duration: float, seed: int) -> np.ndarray:
+        current, amplitude, frequency, speed = reference.values
+        run = config.model_copy(update={
+            "duration": duration, "seed": seed, "settle": min(config.settle, duration / 2),
+            "controller": config.controller.model_copy(update={
+                "kp": gains.kp, "ki": gains.ki, "filter_order": gains.filter_order}),
+            "speed_controller": config.speed_controller.model_copy(update={
+                "kp": gains.kp_speed, "ki": gains.ki_speed}),
+            "reference": CurrentReference(current=current, amplitude=amplitude,
+                                          frequency=frequency, speed=speed),
+        })  # fmt: skip
+        channels, _ = simulate_batch(run, trials=1)
+        return np.column_stack([channels[name][0] for name in CHANNELS])
+
+    return MotorDevice(plant, config.dt)
+
+
+def run_on_rig(config: CurrentControlConfig, link: Link, recorder: Recorder) -> dict[str, float]:
+    """One run of `config` on the rig behind `link`; chapter 4's metrics of its trace."""
+    c = config
+    gains = MotorGains(c.controller.kp, c.controller.ki, c.controller.filter_order,
+                       c.speed_controller.kp, c.speed_controller.ki)  # fmt: skip
+    r = c.reference
+    program = Program(Shape.CURRENT, (r.current, r.amplitude, r.frequency, r.speed))
+    link.command(Kind.SET_GAINS, gains.encode())
+    link.command(Kind.SET_REFERENCE, program.encode())
+    names = [ch.name for ch in link.info.channels]
+    t, rows = run_program(link, c.duration, c.seed, recorder.add)
+    trace = dict(zip(names, rows.T, strict=True))
+    return {k: float(v[0]) for k, v in trace_metrics(c, t, trace).items()}
+
+
+def trace_metrics(
+    config: CurrentControlConfig, t: np.ndarray, trace: dict[str, np.ndarray]
+) -> dict[str, Any]:
+    """Chapter 4's metrics (book/ch4/experiment.py) from a recorded trace: the running sums
+    of loops.motor_current computed from its columns, then metrics_from_sums."""
+    window = metric_window(config)
+    s = window.settle_index
+    i = trace.get("i", trace["i_meas"])
+    i_ref, fed_back = trace["i_ref"], trace["i_fb"]
+    e = i[s:] - i_ref[s:]
+    lag_free = fed_back[s:] - moving_average(i, config.controller.filter_order)[s:]
+    bits, v_max = config.pwm.bits, config.pwm.v_max
+    v_full = v_max if bits == 0 else pwm_voltage((1 << bits) - 1, v_max, bits)
+    sums = {
+        "error": e.sum(), "error_sq": (e * e).sum(), "noise_sq": (lag_free**2).sum(),
+        "omega": trace.get("omega", trace["omega_meas"])[s:].sum(),
+        "saturated": float(np.sum(np.abs(trace["v1"]) >= v_full)),
+        "i": i[s:].sum(), "i_sin": (i * np.sin(window.frequency * t))[s:].sum(),
+        "i_cos": (i * np.cos(window.frequency * t))[s:].sum(),
+    }  # fmt: skip
+    for name, y in (("", i), ("_fb", fed_back)):
+        for level in (10, 90):
+            sums[f"t{level}{name}"] = _first_crossing(t[:s], y[:s], window.rise_target, level)
+    return metrics_from_sums(config, window, {k: np.array([v]) for k, v in sums.items()})
+
+
+def _first_crossing(t: np.ndarray, y: np.ndarray, target: float, percent: int) -> float:
+    """When y first reaches `percent` % of target (NaN: never, or no target)."""
+    if np.isnan(target):  # no rise to time
+        return float("nan")
+    reached = np.nonzero(y / target >= percent / 100)[0]
+    return float(t[reached[0]]) if reached.size else float("nan")
