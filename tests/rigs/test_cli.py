@@ -160,3 +160,11 @@ def test_rig_run_of_fig_4_6_on_the_emulated_motor_rig_is_articula_run(cli, tmp_p
     for key, value in here["metrics"].items():  # null: a metric this run has not (NaN)
         expected = None if value is None else pytest.approx(value, rel=1e-5, abs=1e-6)
         assert rig["metrics"][key] == expected, key
+
+
+def test_a_config_for_another_rig_is_one_line_and_exit_2(emulated_pneunet, cli, tmp_path):
+    proc = cli("rig", "run", emulated_pneunet, packaged("ch4", "fig4_5.toml"), "--out",
+               tmp_path / "run")  # fmt: skip
+    assert proc.returncode == 2
+    assert proc.stderr.strip().splitlines() == [
+        f"error: {emulated_pneunet}: a pneunet rig, not a motor rig"]  # fmt: skip

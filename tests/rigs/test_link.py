@@ -112,3 +112,20 @@ def test_coordinate_descent_over_the_line_tunes_as_in_process():
     assert there.evaluations == here.evaluations
     assert np.allclose(there.k, here.k, rtol=1e-4)  # float32 on the line: the same descent
     assert there.cost == pytest.approx(here.cost, rel=1e-4)
+
+
+def test_a_slow_rig_gets_its_commands_again_and_the_run_completes():
+    # Every reply 0.3 s late, the link waits 0.25 s: each command goes out again (the rig
+    # acknowledges a START it already carried out without starting another run).
+    emulator = Emulator(PneuNetDevice(PARAMS), faults=Faults(delay_ms=300))
+    with emulator, Link(emulator.path, timeout=0.25, retries=3) as link:
+        run = PneuNetRig(link, steps(LEVELS, HOLD), len(LEVELS) * HOLD, 7)(GAINS)
+        assert link.stats.resends >= 4  # HELLO, SET_GAINS, SET_REFERENCE, STREAM, START...
+    here = in_process(7)
+    assert np.allclose(run.measured, here.measured, rtol=1e-6, atol=1e-5)
+
+
+def test_a_rig_that_never_answers_a_command_stops_the_run():
+    emulator = Emulator(PneuNetDevice(PARAMS), faults=Faults(delay_ms=400))
+    with emulator, pytest.raises(PortError, match="no answer to HELLO after 2 tries"):
+        Link(emulator.path, timeout=0.1, retries=1)

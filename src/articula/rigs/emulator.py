@@ -4,7 +4,8 @@ it would open /dev/ttyACM0, and the simulated plant answers in the protocol.
 `--fast` runs samples as fast as the host reads them (the pty's buffer holds the device back
 when the host lags); `--realtime` paces them at the rig's sample period. Faults can be
 injected on the device's frames: drop (probability a frame is not sent), corrupt (probability
-one of its bytes is flipped), delay_ms (before every reply to a command) and reset_at (the
+one of its bytes is flipped), delay_ms (the latency of every reply to a command: later
+commands are read and answered meanwhile, in order) and reset_at (the
 device restarts at that run time [s]: the run ends, its count starts again from 0 and it
 announces itself with an INFO).
 """
@@ -18,6 +19,7 @@ import struct
 import threading
 import time
 import tty
+from collections import deque
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -89,12 +91,15 @@ class Emulator:
         self._samples = 0  # samples of the last run
         self._decimation = 1
         self._thread: threading.Thread | None = None
+        self._replies: deque[tuple[float, Kind, bytes]] = deque()  # (when due, kind, body)
 
     def serve(self) -> None:
         """Answer commands and run the device until stop() (or the pty closes)."""
         while not self._stopped.is_set():
             busy = self._run is not None
             wait = 0.0 if busy and not self.realtime else (self._due() if busy else 0.05)
+            if self._replies:
+                wait = min(wait, self._replies[0][0] - time.monotonic())
             ready, _, _ = select.select([self._master], [], [], max(wait, 0.0))
             if ready:
                 try:
@@ -103,6 +108,9 @@ class Emulator:
                     return  # the pty is gone
                 for raw in self._deframer.feed(data):
                     self._handle(raw)
+            while self._replies and self._replies[0][0] <= time.monotonic():
+                _, kind, body = self._replies.popleft()
+                self._send(kind, body)
             if self._run is not None and self._due() <= 0.0:
                 self._step()
 
@@ -141,18 +149,16 @@ class Emulator:
             frame = protocol.decode(raw)
         except DeviceError:
             return
-        if self.faults.delay_ms:
-            time.sleep(self.faults.delay_ms * 1e-3)
         try:
             self._execute(frame)
         except (DeviceError, struct.error) as exc:
-            self._send(Kind.ERROR, struct.pack("<HB", frame.seq, ErrorCode.BAD_VALUE)
+            self._reply(Kind.ERROR, struct.pack("<HB", frame.seq, ErrorCode.BAD_VALUE)
                        + str(exc).encode("ascii", "replace")[:200])  # fmt: skip
 
     def _execute(self, frame: Frame) -> None:
         """Carry out one command and acknowledge it."""
         if frame.kind == Kind.HELLO:
-            self._send(Kind.INFO, protocol.encode_info(self.device.info))
+            self._reply(Kind.INFO, protocol.encode_info(self.device.info))
             return
         status = b""
         if frame.kind == Kind.START:
@@ -172,7 +178,7 @@ class Emulator:
             (self._decimation,) = struct.unpack("<H", frame.body)
         else:
             self.device.configure(frame.kind, frame.body)
-        self._send(Kind.ACK, struct.pack("<H", frame.seq) + status)
+        self._reply(Kind.ACK, struct.pack("<H", frame.seq) + status)
 
     def _step(self) -> None:
         """One sample of the run; its telemetry; DONE at its end; a reset when one is due."""
@@ -181,6 +187,7 @@ class Emulator:
         if self.faults.reset_at is not None and samples * period >= self.faults.reset_at:
             self.device.stop()
             self._run, self._seq, self._last_start = None, 0, None
+            self._replies.clear()  # what a device had not sent yet dies with it
             self.faults = Faults(self.faults.drop, self.faults.corrupt, self.faults.delay_ms)
             self._send(Kind.INFO, protocol.encode_info(self.device.info))
             return
@@ -194,8 +201,16 @@ class Emulator:
             micros = round(samples * self.device.info.sample_period_us) & 0xFFFFFFFF
             self._send(Kind.TELEMETRY, struct.pack("<I", micros) + protocol.pack_floats(values))
 
+    def _reply(self, kind: Kind, body: bytes) -> None:
+        """An answer to a command: sent now, or after the delay fault's latency."""
+        if self.faults.delay_ms:
+            self._replies.append((time.monotonic() + self.faults.delay_ms * 1e-3, kind, body))
+        else:
+            self._send(kind, body)
+
     def _send(self, kind: Kind, body: bytes) -> None:
-        """One frame to the host, through the faults; every frame takes a sequence number."""
+        """One frame to the host, through the faults; every frame takes the next sequence
+        number as it goes out."""
         wire = protocol.encode(kind, self._seq, body)
         self._seq = (self._seq + 1) & 0xFFFF
         if self._rng.random() < self.faults.drop:

@@ -166,20 +166,25 @@ class Link:
             except DeviceError:
                 self.stats.crc_errors += 1
                 continue
-            self._count(frame)
-            self.inbox.append(frame)
-            got = True
+            if self._count(frame):
+                self.inbox.append(frame)
+                got = True
         return got
 
-    def _count(self, frame: Frame) -> None:
-        """Track the device's sequence: gaps are losses; an INFO not asked for is a reset (a
-        device sends one when it starts, its count from 0)."""
+    def _count(self, frame: Frame) -> bool:
+        """Track the device's sequence (gaps are losses); False for a frame to drop. An INFO
+        not asked for is a reset when it counts from 0 (a device that starts sends one),
+        else the late answer to a HELLO sent again."""
         self.stats.frames += 1
         last, self._device_seq = self._device_seq, frame.seq
-        if frame.kind == Kind.INFO and not self._expecting_info:  # a device says it first
-            raise DeviceResetError(f"{self.port}: the device restarted (a reset or a power loss)")
-        if last is not None and frame.kind != Kind.INFO:
+        if frame.kind == Kind.INFO and not self._expecting_info:
+            if frame.seq == 0:
+                raise DeviceResetError(f"{self.port}: the device restarted (a reset or a "
+                                       "power loss)")  # fmt: skip
+            return False
+        if last is not None:
             self.stats.dropped += (frame.seq - last - 1) & 0xFFFF
+        return True
 
 
 def _acked(frame: Frame) -> int:
