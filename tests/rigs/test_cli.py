@@ -71,25 +71,34 @@ def test_rig_run_writes_a_run_folder_with_the_lines_losses(emulated_pneunet, pid
     assert len(journal) == 1 + 240  # a header, then every sample as it came
 
 
-@pytest.mark.parametrize("ending", ["reset", "unplug"])
+ENDINGS = {  # how a run is cut short: exit status, and what its one line says
+    "reset": (1, "restarted"),
+    "unplug": (1, "went down"),
+    "ctrl-c": (130, "interrupted"),
+}
+
+
+@pytest.mark.parametrize("ending", list(ENDINGS))
 def test_a_run_cut_short_keeps_what_came_and_says_why(pid_config, tmp_path, ending):
     options = ["--realtime", "--faults", "reset_at=1.0"] if ending == "reset" else ["--realtime"]
     emulator, path = emulate(*options)
+    status, words = ENDINGS[ending]
     try:
         run = subprocess.Popen([ARTICULA, "rig", "run", path, pid_config, "--out",
                                 tmp_path / "run"], stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True)  # fmt: skip
+        time.sleep(1.5)
         if ending == "unplug":
-            time.sleep(1.5)
             emulator.kill()
-        assert run.wait(30) == 1
+        elif ending == "ctrl-c":
+            run.send_signal(signal.SIGINT)
+        assert run.wait(30) == status
         error = run.stderr.read().strip().splitlines()
-        assert len(error) == 1
-        assert ("restarted" if ending == "reset" else "went down") in error[0]
+        assert len(error) == 1 and words in error[0]
     finally:
         emulator.kill()
     record = json.loads((tmp_path / "run" / "record.json").read_text())
-    assert not record["complete"] and record["incomplete"] in error[0]
+    assert not record["complete"] and words in record["incomplete"]
     rows = pq.read_table(tmp_path / "run" / "trace.parquet").num_rows
     assert 10 < rows == record["samples"] < 240
 

@@ -31,7 +31,9 @@ def main(argv: list[str] | None = None) -> None:
     debug = bool(os.environ.get("ARTICULA_DEBUG"))
     with warnings.catch_warnings(record=not debug) as caught:
         try:
-            app(args=argv, standalone_mode=False)
+            # Typer turns a Ctrl-C inside a command into Exit(130), which this mode returns.
+            if app(args=argv, standalone_mode=False) == INTERRUPTED:
+                raise KeyboardInterrupt
         except Exit as exc:
             sys.exit(exc.exit_code)
         except Exception as exc:  # every failure, ours or not, ends here as one line
@@ -39,7 +41,8 @@ def main(argv: list[str] | None = None) -> None:
                 raise
             _fail(*_status_and_message(exc))
         except KeyboardInterrupt:
-            _fail(INTERRUPTED, "interrupted; finished runs are kept and a re-run resumes")
+            _fail(INTERRUPTED, "interrupted (Ctrl-C); finished work is kept: a sweep resumes, a "
+                  "rig run's folder says it is incomplete")  # fmt: skip
     if caught:
         first = f"{_one_line(str(caught[0].message))} ({caught[0].category.__name__})"
         sys.stderr.write(f"warning: {len(caught)} warning(s), the first: {first}\n")
