@@ -11,7 +11,8 @@ import time
 import pyarrow.parquet as pq
 import pytest
 
-from articula.book.ch2.tuning import AutoConfig, TuningConfig, auto_run
+from articula.book.ch2.study import ziegler_nichols_at_90
+from articula.book.ch2.tuning import AutoConfig, ManualConfig, TuningConfig, auto_run, manual_run
 from articula.book.study import packaged
 from tests.conftest import ARTICULA
 
@@ -177,3 +178,23 @@ def test_a_config_for_another_rig_is_one_line_and_exit_2(emulated_pneunet, cli, 
     assert proc.returncode == 2
     assert proc.stderr.strip().splitlines() == [
         f"error: {emulated_pneunet}: a pneunet rig, not a motor rig"]  # fmt: skip
+
+
+@pytest.mark.parametrize("method", ["manual", "ziegler-nichols"])
+def test_rig_tune_runs_chapter_2s_other_tuners_as_in_process(emulated_pneunet, cli, tmp_path,
+                                                             method):  # fmt: skip
+    config = tmp_path / "tuning.toml"
+    config.write_text("[manual]\nseed = 1000\nhold = 4.0\n")
+    proc = cli("rig", "tune", emulated_pneunet, "--method", method, "--config", config,
+               "--levels", "90", "--out", tmp_path / "tune", "--json")  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    result = json.loads(proc.stdout)
+    tuning = TuningConfig(manual=ManualConfig(seed=1000, hold=4.0))
+    if method == "manual":
+        here = manual_run(tuning, 90.0)
+        assert result["experiments"] == len(here.trials)
+        assert result["gains"] == pytest.approx(here.gains.tolist(), rel=1e-4)
+    else:
+        here = ziegler_nichols_at_90(tuning)
+        assert (result["ku"], result["tu_s"]) == pytest.approx((here.ku, here.tu), rel=1e-4)
+        assert result["gains"] == pytest.approx(here.pid.tolist(), rel=1e-4)

@@ -202,37 +202,43 @@ def record(
 def tune(
     port: Port,
     out_dir: OutDir,
+    method: Annotated[
+        str, typer.Option(help="descent (Algorithm 1), manual or ziegler-nichols.")
+    ] = "descent",
     config: Annotated[
         Path | None,
-        typer.Option(
-            help="A chapter-2 tuning config ([auto] table; default: the book's quick one)."
-        ),
+        typer.Option(help="A chapter-2 tuning config (default: the book's quick one)."),
     ] = None,
-    levels: Annotated[str, typer.Option(help="Reference levels [deg], comma-separated.")] = "30,60",
+    levels: Annotated[
+        str,
+        typer.Option(
+            help="Reference levels [deg], comma-separated (manual and "
+            "ziegler-nichols: a step to the first)."
+        ),
+    ] = "30,60",
     index: Annotated[int, typer.Option(min=0, help="Which run of the config's seeds.")] = 0,
     force: Force = False,
     as_json: JsonFlag = False,
 ) -> None:
-    """Tune the PneuNet rig's PID by coordinate descent (chapter 2, Algorithm 1), one
-    experiment on the rig per probe; writes tuning.json.
+    """Tune the PneuNet rig's PID with chapter 2's tuners, one experiment on the rig per
+    probe (counted live); writes tuning.json.
 
-    Example: articula rig tune /dev/ttyACM0 --levels 30,60 --out runs/tuning"""
+    Example: articula rig tune /dev/ttyACM0 --method descent --levels 30,60 --out runs/tuning"""
     import json
 
-    import numpy as np
-
-    from articula.book.ch2.tuning import TuningConfig, auto_run, auto_seed
+    from articula.book.ch2.rig import TUNERS, tune_on_rig
+    from articula.book.ch2.tuning import TuningConfig
     from articula.book.study import packaged
     from articula.errors import ConfigError
     from articula.rigs.link import Link
-    from articula.rigs.pneunet import PneuNetRig
-    from articula.rigs.programs import steps
     from articula.rigs.protocol import RigKind
     from articula.runs.folders import TUNING, claimed
     from articula.runs.records import atomic_write
-    from articula.tuning.response import Response
     from articula.validation import load_toml, parse_model
 
+    if method not in TUNERS:
+        raise ConfigError("--method", f"unknown tuner {method!r}; choose one of "
+                          f"{', '.join(TUNERS)}")  # fmt: skip
     try:
         chosen = tuple(float(v) for v in levels.split(","))
     except ValueError:
@@ -241,27 +247,15 @@ def tune(
         ) from None
     data = load_toml(config or packaged("ch2", "tuning_quick.toml"))
     tuning = parse_model(TuningConfig, data, str(config or "tuning_quick.toml"))
-    a = tuning.auto
     with claimed(out_dir, "run", force), Link(port, RigKind.PNEUNET) as link:
-        rig = PneuNetRig(
-            link, steps(chosen, a.hold), len(chosen) * a.hold, auto_seed(tuning, index)
-        )
         with progress_bar(as_json) as bar:
-            task = bar.add_task("experiments on the rig", total=None)
-
-            def probe(k: np.ndarray) -> Response:
-                bar.advance(task)
-                return rig(k)
-
-            run = auto_run(tuning, chosen, index, rig=probe)
-        result = {"levels_deg": list(chosen), "gains": run.result.k.tolist(),
-                  "cost": run.result.cost, "experiments": run.result.evaluations,
-                  "sweeps": len(run.result.history) - 1,
-                  "link": dataclasses.asdict(link.stats)}  # fmt: skip
+            task = bar.add_task(f"{method}: experiments on the rig", total=None)
+            result = tune_on_rig(tuning, link, method, chosen, index, lambda: bar.advance(task))
+        result["link"] = dataclasses.asdict(link.stats)
         atomic_write(out_dir / TUNING, json.dumps(result, indent=2).encode())
     if as_json:
         emit_json(result)
         return
     kp, ki, kd = result["gains"]
-    out.print(f"K_p = {kp:.4g}, K_i = {ki:.4g}, K_d = {kd:.4g}: M = {result['cost']:.4g} "
-              f"after {result['experiments']} experiments; in {out_dir / TUNING}")  # fmt: skip
+    out.print(f"{method}: K_p = {kp:.4g}, K_i = {ki:.4g}, K_d = {kd:.4g} after "
+              f"{result['experiments']} experiments; in {out_dir / TUNING}")  # fmt: skip

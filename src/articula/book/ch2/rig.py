@@ -1,4 +1,5 @@
-"""Chapter 2's experiment on a PneuNet rig over serial (`articula rig run`).
+"""Chapter 2 on a PneuNet rig over serial: its experiment (`articula rig run`) and its
+tuners (`articula rig tune`).
 
 The config is the one `articula run` takes (pneunet.pid); the rig runs its gain schedule
 against its reference, one run from rest per trial (noise seed seed + i on an emulated rig),
@@ -8,18 +9,30 @@ sensor's angle: a rig has no other.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 
 from articula.book.ch2.experiment import AngleReference, PneuNetPidConfig
+from articula.book.ch2.study import ZN_LADDER, ZN_SEED_OFFSET
+from articula.book.ch2.tuning import TuningConfig, auto_run, auto_seed, manual_seed
 from articula.control.pid import GainSchedule
 from articula.errors import ConfigError
 from articula.rigs.link import Link
-from articula.rigs.pneunet import encode_gains
+from articula.rigs.pneunet import PneuNetRig, encode_gains
 from articula.rigs.programs import Program, Shape, steps
 from articula.rigs.protocol import Kind
 from articula.rigs.recorder import Recorder
 from articula.rigs.run import run_program
-from articula.tuning.response import tracking_error, tuning_cost
+from articula.tuning.manual import (
+    GainExperiment,
+    ManualSettings,
+    manual_tuning,
+    ultimate_gain,
+    ziegler_nichols,
+)
+from articula.tuning.response import Response, tracking_error, tuning_cost
 
 CHANNELS = ("trial", "theta_ref_deg", "theta_meas_deg", "pwm")  # the recorder's columns
 
@@ -53,3 +66,52 @@ def run_on_rig(config: PneuNetPidConfig, link: Link, recorder: Recorder) -> dict
     q1, median, q3 = np.percentile(errors, [25, 50, 75])
     return {"error_median_deg": float(median), "error_q1_deg": float(q1),
             "error_q3_deg": float(q3), "cost_median": float(np.median(costs))}  # fmt: skip
+
+
+TUNERS = ("descent", "manual", "ziegler-nichols")
+
+
+def tune_on_rig(
+    tuning: TuningConfig,
+    link: Link,
+    method: str,
+    levels: tuple[float, ...],
+    index: int = 0,
+    on_experiment: Callable[[], None] | None = None,
+) -> dict[str, Any]:
+    """Chapter 2's tuners, unchanged, with the rig behind `link` as their experiment: the
+    coordinate descent (Algorithm 1) on steps through `levels`, the scripted manual procedure
+    or Ziegler-Nichols' ultimate gain on a step to levels[0] [°]; the noise seeds are the
+    in-process runs' (an emulated rig then gives their numbers). Returns the result as JSON."""
+
+    def rig(program_levels: tuple[float, ...], hold: float, seed: int) -> GainExperiment:
+        on_rig = PneuNetRig(link, steps(program_levels, hold), len(program_levels) * hold, seed)
+
+        def experiment(k: np.ndarray) -> Response:
+            if on_experiment is not None:
+                on_experiment()
+            return on_rig(k)
+
+        return experiment
+
+    m, level = tuning.manual, levels[0]
+    if method == "descent":
+        run = auto_run(tuning, levels, index, rig(levels, tuning.auto.hold,
+                                                  auto_seed(tuning, index))).result  # fmt: skip
+        return {"method": method, "levels_deg": list(levels), "gains": run.k.tolist(),
+                "cost": run.cost, "experiments": run.evaluations,
+                "sweeps": len(run.history) - 1}  # fmt: skip
+    if method == "manual":
+        experiment = rig((level,), m.hold, manual_seed(tuning, level))
+        found = manual_tuning(experiment, ManualSettings(band=m.band, tolerance=m.tolerance))
+        return {"method": method, "levels_deg": [level], "gains": found.gains.tolist(),
+                "experiments": len(found.trials),
+                "within_tolerance": found.within_tolerance}  # fmt: skip
+    if method != "ziegler-nichols":
+        raise ConfigError("--method", f"unknown tuner {method!r}; choose one of {TUNERS}")
+    ku, tu, trials = ultimate_gain(rig((level,), m.hold, m.seed + ZN_SEED_OFFSET), ZN_LADDER,
+                                   m.band)  # fmt: skip
+    return {"method": method, "levels_deg": [level], "ku": ku, "tu_s": tu,
+            "gains": ziegler_nichols(ku, tu, "PID").tolist(),
+            "gains_pi": ziegler_nichols(ku, tu, "PI").tolist(),
+            "experiments": len(trials)}  # fmt: skip

@@ -75,7 +75,7 @@ def manual_run(config: TuningConfig, level: float) -> ManualResult:
     """The manual procedure on steps from rest to `level` [°]."""
     m = config.manual
     reference = step_reference((level,), m.hold, config.plant.pwm_period)
-    rig = SimulatedRig(config.plant, reference, m.seed + int(level) * 100)
+    rig = SimulatedRig(config.plant, reference, manual_seed(config, level))
     settings = ManualSettings(band=m.band, tolerance=m.tolerance)
     return manual_tuning(rig, settings)
 
@@ -107,6 +107,11 @@ def auto_run(
         cost, k0, dk0, a.k_stop, a.max_iterations, lower=np.zeros(3), upper=np.array(a.upper)
     )
     return TuningRun(levels, result)
+
+
+def manual_seed(config: TuningConfig, level: float) -> int:
+    """The first noise seed of the manual procedure on a step to `level` [°]."""
+    return config.manual.seed + int(level) * 100
 
 
 def auto_seed(config: TuningConfig, index: int) -> int:
