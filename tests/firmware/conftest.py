@@ -1,0 +1,47 @@
+"""Fixtures of the firmware tests: the firmware built with its Makefile, run in simavr."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+
+FIRMWARE = Path(__file__).resolve().parents[2] / "firmware"
+TOOLCHAIN = "apt-get install -y gcc-avr avr-libc simavr libsimavr-dev"
+
+
+@pytest.fixture(scope="session")
+def built(tmp_path_factory) -> Path:
+    """The build folder of `make -C firmware` (skip without the AVR toolchain and simavr)."""
+    if shutil.which("avr-gcc") is None or not Path("/usr/include/simavr/sim_avr.h").is_file():
+        pytest.skip(TOOLCHAIN)
+    build = tmp_path_factory.mktemp("firmware")
+    proc = subprocess.run(["make", "-C", str(FIRMWARE), f"BUILD={build}"], capture_output=True,
+                          text=True, timeout=300)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    return build
+
+
+@pytest.fixture
+def simavr(built) -> Iterator[Callable[[str], str]]:
+    """simavr(name) runs build/<name>.elf in the harness; its UART0's device path. Every
+    harness started is killed after the test."""
+    started: list[subprocess.Popen] = []
+
+    def run(name: str) -> str:
+        proc = subprocess.Popen([built / "harness", built / f"{name}.elf"],
+                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                text=True)  # fmt: skip
+        started.append(proc)
+        for line in proc.stdout:  # simavr's own lines first, then ours
+            if line.startswith("uart0 at "):
+                return line.split()[-1]
+        raise AssertionError(f"the harness ended: {proc.wait()}")
+
+    yield run
+    for proc in started:
+        proc.kill()
+        proc.wait(10)
