@@ -146,13 +146,7 @@ def run_(
     driver = importlib.import_module(module)
     with claimed(out_dir, "run", force), Link(port, RigKind[rig]) as link:
         recorder = Recorder(out_dir, config_to_dict(exp, cfg), driver.CHANNELS)
-        try:
-            metrics = driver.run_on_rig(cfg, link, recorder)
-        except BaseException as exc:  # whatever stops the run, what was received is kept
-            why = "interrupted (Ctrl-C)" if isinstance(exc, KeyboardInterrupt) else str(exc)
-            recorder.finish({}, link.stats, incomplete=why)
-            raise
-        record = recorder.finish(metrics, link.stats)
+        record = recorder.capture(lambda: driver.run_on_rig(cfg, link, recorder), link.stats)
     if as_json:
         emit_json(record)
         return
@@ -185,13 +179,12 @@ def record(
         config = {"experiment": "rig.record", "port": port, "duration": duration, "seed": seed,
                   "rig": link.info.rig.name.lower()}  # fmt: skip
         recorder = Recorder(out_dir, config, channels)
-        try:
+
+        def take() -> dict[str, float]:
             run_program(link, duration, seed, recorder.add)
-        except BaseException as exc:  # whatever stops the run, what was received is kept
-            why = "interrupted (Ctrl-C)" if isinstance(exc, KeyboardInterrupt) else str(exc)
-            recorder.finish({}, link.stats, incomplete=why)
-            raise
-        summary = recorder.finish({}, link.stats)
+            return {}  # a recording has no metrics
+
+        summary = recorder.capture(take, link.stats)
     if as_json:
         emit_json(summary)
         return

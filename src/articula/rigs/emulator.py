@@ -20,6 +20,7 @@ import threading
 import time
 import tty
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -42,6 +43,32 @@ class Device(Protocol):
     def sample(self) -> np.ndarray | None: ...
 
     def stop(self) -> None: ...
+
+
+class PlayedRun:
+    """A device's run simulated whole at its first sample, after START is acknowledged (as
+    firmware answers at once), then played out a sample per period: for plants that are
+    simulated in one batch. A device calls `_begin(compute)` in its start()."""
+
+    _rows: np.ndarray | None = np.zeros((0, 0))
+    _n = 0
+
+    def _begin(self, compute: Callable[[], np.ndarray]) -> None:
+        """A new run whose samples `compute` returns (one row each)."""
+        self._compute, self._rows, self._n = compute, None, 0
+
+    def sample(self) -> np.ndarray | None:
+        """The run's next sample; None when it is over."""
+        if self._rows is None:
+            self._rows = self._compute()
+        if self._n >= len(self._rows):
+            return None
+        self._n += 1
+        return self._rows[self._n - 1]
+
+    def stop(self) -> None:
+        """End the run."""
+        self._rows = np.zeros((0, 0))
 
 
 @dataclass(frozen=True)

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from articula.errors import DeviceError
+from articula.rigs.emulator import PlayedRun
 from articula.rigs.programs import Program, Shape
 from articula.rigs.protocol import PROTOCOL_VERSION, Channel, Info, Kind, RigKind
 
@@ -58,7 +59,7 @@ class MotorGains:
 Plant = Callable[[MotorGains, Program, float, int], np.ndarray]
 
 
-class MotorDevice:
+class MotorDevice(PlayedRun):
     """The rig's program, run by the emulator against a simulated dual-motor rig."""
 
     def __init__(self, plant: Plant, dt: float) -> None:
@@ -67,7 +68,6 @@ class MotorDevice:
         self.info = Info(RigKind.MOTOR, PROTOCOL_VERSION, FIRMWARE, round(dt * 1e6), channels)
         self.gains = MotorGains()
         self.reference = Program(Shape.CURRENT, (1.0, 0.0, 0.0, 5.0))
-        self._rows: np.ndarray | None = np.zeros((0, len(channels)))
 
     def configure(self, kind: int, body: bytes) -> None:
         """Take SET_GAINS (MotorGains) or SET_REFERENCE (a current program)."""
@@ -82,23 +82,7 @@ class MotorDevice:
             raise DeviceError(f"the motor rig does not take {Kind(kind).name}")
 
     def start(self, duration: float, seed: int) -> None:
-        """A run of `duration` [s] from rest; the plant runs at the first sample, after
-        START is acknowledged (as firmware would)."""
+        """A run of `duration` [s] from rest; the plant runs at the first sample (PlayedRun)."""
         if not duration > 0:
             raise DeviceError(f"the run's duration must be > 0 (got {duration:g} s)")
-        self._run = (duration, seed)
-        self._rows = None
-        self._n = 0
-
-    def sample(self) -> np.ndarray | None:
-        """The next control period's channels; None when the run is over."""
-        if self._rows is None:
-            self._rows = self.plant(self.gains, self.reference, *self._run)
-        if self._n >= len(self._rows):
-            return None
-        self._n += 1
-        return self._rows[self._n - 1]
-
-    def stop(self) -> None:
-        """End the run: both motors off."""
-        self._rows = np.zeros((0, len(self.info.channels)))
+        self._begin(lambda: self.plant(self.gains, self.reference, duration, seed))

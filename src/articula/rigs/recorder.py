@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -51,6 +51,18 @@ class Recorder:
         """The samples so far as trace columns (t and one per channel)."""
         values = np.array(self.rows).reshape(-1, len(self.channels))
         return {"t": np.array(self.t), **dict(zip(self.channels, values.T, strict=True))}
+
+    def capture(self, run: Callable[[], Mapping[str, float]], stats: LinkStats) -> dict[str, Any]:
+        """Do `run` (which feeds `add` and returns the metrics) and write the run folder;
+        whatever stops it, what was received is written, marked incomplete, and the error
+        goes on. Returns the record."""
+        try:
+            metrics = run()
+        except BaseException as exc:
+            why = "interrupted (Ctrl-C)" if isinstance(exc, KeyboardInterrupt) else str(exc)
+            self.finish({}, stats, incomplete=why)
+            raise
+        return self.finish(metrics, stats)
 
     def finish(
         self, metrics: Mapping[str, float], stats: LinkStats, incomplete: str | None = None

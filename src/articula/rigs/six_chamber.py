@@ -18,6 +18,7 @@ from articula.errors import ConfigError, DeviceError
 from articula.loops.six_chamber import deactuate, valve_program
 from articula.plants.orientation_sensor import OrientationSensorParams
 from articula.plants.six_chamber import SixChamberParams
+from articula.rigs.emulator import PlayedRun
 from articula.rigs.programs import Program, Shape
 from articula.rigs.protocol import PROTOCOL_VERSION, Channel, Info, Kind, RigKind
 
@@ -32,7 +33,7 @@ def encode_damping(policy: DampingPolicy) -> bytes:
     return struct.pack("<fff", policy.delta, policy.start, policy.length)
 
 
-class SixChamberDevice:
+class SixChamberDevice(PlayedRun):
     """The rig's program, run by the emulator against the simulated actuator and sensor."""
 
     def __init__(
@@ -46,7 +47,6 @@ class SixChamberDevice:
         self.info = Info(RigKind.SIX_CHAMBER, PROTOCOL_VERSION, FIRMWARE, period_us, CHANNELS)
         self.actuation = Program(Shape.ACTUATION, (0.0, self.actuator.supply, 1.0))
         self.damping = DampingPolicy()
-        self._samples: np.ndarray | None = np.zeros((0, 2))
         # The plant's compiled code loads (or compiles) now, not while a host waits on a run.
         program = valve_program(self.actuator, 0.0, 1.0, 0.01, self.damping)
         deactuate(self.actuator, self.sensor, program, 0.0, 0.01, 0.01, STEP, RECORD_EVERY,
@@ -70,29 +70,17 @@ class SixChamberDevice:
 
     def start(self, duration: float, seed: int) -> None:
         """Fill, hold, vent and damp over `duration` [s]; the sensor's noise from seed. The
-        plant runs at the first sample, after START is acknowledged (as firmware would)."""
+        plant runs at the first sample (PlayedRun); the stream is the sensor's samples."""
         side, gauge, hold = self.actuation.values
         if not hold < duration:
             raise DeviceError(f"the run ({duration:g} s) ends before the vent ({hold:g} s)")
         if not 0.0 < gauge <= self.actuator.supply:
             raise DeviceError(f"pressure {gauge:g} Pa is outside (0, {self.actuator.supply:g}]")
-        self._run = (side, gauge, hold, duration, seed)
-        self._samples = None
-        self._n = 0
 
-    def sample(self) -> np.ndarray | None:
-        """The next sensor sample (bend_x, bend_y [deg]); None when the run is over."""
-        if self._samples is None:
-            side, gauge, hold, duration, seed = self._run
+        def run() -> np.ndarray:
             program = valve_program(self.actuator, side, gauge, hold, self.damping)
-            run = deactuate(self.actuator, self.sensor, program, side, hold, duration - hold,
-                            STEP, RECORD_EVERY, np.random.default_rng(seed))  # fmt: skip
-            self._samples = np.degrees(run.sensor_bend)
-        if self._n >= len(self._samples):
-            return None
-        self._n += 1
-        return self._samples[self._n - 1]
+            done = deactuate(self.actuator, self.sensor, program, side, hold, duration - hold,
+                             STEP, RECORD_EVERY, np.random.default_rng(seed))  # fmt: skip
+            return np.degrees(done.sensor_bend)  # (bend_x, bend_y) [deg] per sensor sample
 
-    def stop(self) -> None:
-        """End the run: every valve vents."""
-        self._samples = np.zeros((0, 2))
+        self._begin(run)
