@@ -93,7 +93,13 @@ def test_a_silent_port_a_wrong_rig_and_another_protocol_are_refused():
 
 @pytest.mark.parametrize(
     ("text", "error"),
-    [("drop=2", "probability"), ("wobble=1", "unknown fault"), ("drop=x", "number")],
+    [
+        ("drop=2", "probability"),
+        ("wobble=1", "unknown fault"),
+        ("drop=x", "number"),
+        ("delay_ms=-5", "finite time"),
+        ("reset_at=nan", "finite time"),
+    ],
 )
 def test_bad_faults_name_the_problem(text, error):
     with pytest.raises(ValueError, match=error):

@@ -96,6 +96,9 @@ class Faults:
         for name in ("drop", "corrupt"):
             if not 0.0 <= values.get(name, 0.0) < 1.0:
                 raise ConfigError("--faults", f"{name} is a probability in [0, 1)")
+        for name in ("delay_ms", "reset_at"):
+            if not 0.0 <= values.get(name, 0.0) < float("inf"):
+                raise ConfigError("--faults", f"{name} is a finite time >= 0")
         return cls(**values)
 
 
