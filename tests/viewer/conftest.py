@@ -109,9 +109,12 @@ def open_page(browser, url: str, wait_for: str = "closest:"):
 
 
 def screenshot(page) -> np.ndarray:
-    """The tab as an RGB array (rows, columns, 3)."""
+    """The tab as an RGB array (rows, columns, 3), brought to the front first: Chromium does
+    not draw a background tab (with two open, the first one's picture can be blank)."""
     from PIL import Image
 
+    page.bring_to_front()
+    page.wait_for_timeout(1000)  # a few frames of software WebGL
     return np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB")).astype(int)
 
 
