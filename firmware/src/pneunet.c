@@ -1,46 +1,211 @@
-/* The PneuNet rig's firmware (chapter 2), first step: the handshake of docs/protocol.md.
- * INFO is byte for byte what articula's emulated PneuNet sends (rigs/pneunet.py); every other
- * command is refused with ERROR "unknown" until the 30 Hz PID loop lands (issue 16). */
-#include <stdint.h>
-#include <string.h>
+/* The PneuNet rig's firmware (chapter 2): the PID family on the flex sensor at the valve's
+ * 30 Hz PWM, as articula's emulated rig runs it (rigs/pneunet.py, control/pid.py), in
+ * float32.
+ *
+ * Timer1 runs the valve's PWM on D11 (OC1A): 8333 ticks of 4 µs, 33.332 ms (the book's
+ * 1/30 s to 0.01 %). At each period's start its overflow interrupt starts a conversion of
+ * the flex sensor's divider on A0; the conversion's interrupt evaluates the PID (2.2)-(2.4)
+ * with gains scheduled on the reference (constant, piecewise or fuzzy), anti-windup at the
+ * 0-255 range, and writes the period's duty. The pump on D8 runs during a run. */
+#include <avr/interrupt.h>
+#include <avr/io.h>
+#include <math.h>
 
+#include "probe.h"
 #include "protocol.h"
+#include "rig.h"
 #include "uart.h"
 
-#define RIG_PNEUNET 1
-#define SAMPLE_PERIOD_US 33333UL /* the book's 30 Hz valve PWM */
+#define RATE_HZ 30.0f              /* the valve's PWM frequency */
+#define DT (1.0f / RATE_HZ)        /* [s] */
+#define TICKS 8333                 /* Timer1 ticks per period (prescaler 64) */
+#define SENSOR_ZERO 1.0f           /* [V] the divider at 0° */
+#define SENSOR_GAIN (2.5f / (float)M_PI_2) /* [V/rad]: 2.5 V over 0-90° */
+#define ADC_VREF 5.0f              /* [V] */
+#define DEG_PER_RAD (180.0f / (float)M_PI)
+#define MAX_ROWS 8                 /* gain-schedule rows */
+#define MAX_LEVELS 60              /* levels of a steps program */
+enum shape { CONSTANT = 0, STEPS = 1, SINUSOID = 2 }; /* programs.py's Shape */
+enum schedule { FIXED = 0, PIECEWISE = 1, FUZZY = 2 }; /* "constant", "piecewise", "fuzzy" */
 
 static const char *const channels[][2] = {{"reference", "deg"}, {"angle", "deg"},
                                           {"pwm", "counts"}};
 
-static void send_info(void) {
-    static uint8_t body[96];
-    uint8_t n = 0;
-    body[n++] = PROTOCOL_VERSION;
-    body[n++] = RIG_PNEUNET;
-    body[n++] = 0; /* firmware 0.1.0 */
-    body[n++] = 1;
-    body[n++] = 0;
-    for (uint8_t k = 0; k < 4; k++) body[n++] = (uint8_t)(SAMPLE_PERIOD_US >> (8 * k));
-    body[n++] = 3;
-    for (uint8_t c = 0; c < 3; c++) {
-        for (uint8_t t = 0; t < 2; t++) {
-            uint8_t length = (uint8_t)strlen(channels[c][t]);
-            body[n++] = length;
-            memcpy(body + n, channels[c][t], length);
-            n = (uint8_t)(n + length);
-        }
-    }
-    frame_send(INFO, body, n);
+/* Settings: the gain schedule (rows of K_p, K_i, K_d at their points), the reference
+ * program, an open-loop PWM count (SET_OUTPUT; negative: closed loop). */
+static uint8_t schedule = FIXED, rows = 1;
+static float gains[MAX_ROWS][3] = {{1.0f, 1.0f, 0.0f}};
+static float points[MAX_ROWS];
+static uint8_t shape = CONSTANT, levels = 1;
+static float values[MAX_LEVELS + 1]; /* constant: value; steps: hold, levels; sinusoid */
+static float open_loop = -1.0f;
+
+/* The run. */
+static uint32_t n, steps;
+static float integral, last_error;
+
+/* The reference at step n (programs.py's Program.at). */
+static float reference_at(uint32_t step) {
+    if (shape == CONSTANT) return values[0];
+    if (shape == SINUSOID) /* offset - amplitude cos(2π f t): from rest */
+        return values[0] - values[1] * cosf(2.0f * (float)M_PI * values[2] * (float)step * DT);
+    /* steps: level floor(t / hold), the last held to the end; in periods, t = n / 30 s */
+    float index = floorf((float)step / (values[0] * RATE_HZ) + 1e-6f);
+    return values[1 + (index < levels - 1 ? (uint8_t)index : levels - 1)];
 }
+
+/* Gain j (K_p, K_i, K_d) at reference r: GainSchedule.__call__. */
+static float gain(uint8_t j, float r) {
+    if (schedule == FIXED) return gains[0][j];
+    uint8_t k = 0;
+    if (schedule == PIECEWISE) { /* the subranges meet half-way between points */
+        while (k + 1 < rows && r >= 0.5f * (points[k] + points[k + 1])) k++;
+        return gains[k][j];
+    }
+    if (r <= points[0]) return gains[0][j]; /* fuzzy: linear between points, flat beyond */
+    if (r >= points[rows - 1]) return gains[rows - 1][j];
+    while (r > points[k + 1]) k++;
+    float w = (r - points[k]) / (points[k + 1] - points[k]);
+    return gains[k][j] + w * (gains[k + 1][j] - gains[k][j]);
+}
+
+ISR(TIMER1_OVF_vect) {
+    probe_busy();
+    ADCSRA |= _BV(ADSC); /* the flex sensor on A0 */
+    probe_idle();
+}
+
+ISR(ADC_vect) {
+    probe_busy();
+    uint16_t code = ADC;
+    const float deg_per_code = ADC_VREF / 1024.0f / SENSOR_GAIN * DEG_PER_RAD;
+    const float deg_at_zero = (0.5f * ADC_VREF / 1024.0f - SENSOR_ZERO) / SENSOR_GAIN * DEG_PER_RAD;
+    float angle = (float)code * deg_per_code + deg_at_zero; /* mid-step reconstruction */
+    float reference = reference_at(n);
+    float u;
+    if (open_loop >= 0.0f) {
+        u = open_loop;
+    } else {
+        float error = reference - angle; /* e[n] = θ_r − θ[n] */
+        float sum = integral, derivative = 0.0f;
+        if (n > 0) { /* the first sample has no Δt: nothing to integrate or differentiate */
+            sum = integral + error * DT;           /* Σ e[i] Δt, (2.2) */
+            derivative = (error - last_error) / DT; /* Δe/Δt, (2.2) */
+        }
+        float kp = gain(0, reference), ki = gain(1, reference), kd = gain(2, reference);
+        float proportional = kp * error + kd * derivative;
+        u = proportional + ki * sum; /* u = K(θ_r)ᵀ E, (2.3)-(2.4) */
+        /* Anti-windup: the old sum stays where integrating would push further past a limit. */
+        if ((u > 255.0f && ki * error > 0.0f) || (u < 0.0f && ki * error < 0.0f))
+            u = proportional + ki * integral;
+        else
+            integral = sum;
+        last_error = error;
+    }
+    uint8_t count = u >= 255.0f ? 255 : (u <= 0.0f ? 0 : (uint8_t)u); /* floor in [0, 255] */
+    OCR1A = (uint16_t)(((uint32_t)count * TICKS + 127) / 255); /* the period's duty */
+    float sample[3] = {reference, angle, count};
+    rig_sample(sample);
+    if (++n >= steps) {
+        TIMSK1 = 0;
+        OCR1A = 0;
+        PORTH &= (uint8_t)~_BV(PH5);
+        rig_done();
+    }
+    probe_idle();
+}
+
+static uint8_t configure(uint8_t kind, const uint8_t *body, uint8_t length, const char **why) {
+    if (kind == SET_GAINS) {
+        uint8_t count = length >= 2 ? body[1] : 0;
+        if (length < 2 || body[0] > FUZZY || length != 2 + 16 * count) {
+            *why = "SET_GAINS does not decode";
+            return BAD_FRAME;
+        }
+        if (count < 1 || count > MAX_ROWS || (body[0] == FIXED && count != 1)) {
+            *why = "SET_GAINS: one row for constant gains, up to 8 for a schedule";
+            return BAD_VALUE;
+        }
+        for (uint8_t k = 0; k < count; k++) {
+            for (uint8_t j = 0; j < 3; j++) gains[k][j] = read_float(body, (uint8_t)(2 + 16 * k + 4 * j));
+            points[k] = read_float(body, (uint8_t)(2 + 16 * k + 12));
+        }
+        schedule = body[0], rows = count;
+        return 0;
+    }
+    if (kind == SET_REFERENCE) {
+        uint8_t count = length >= 2 ? body[1] : 0;
+        if (length < 2 || length != 2 + 4 * count) {
+            *why = "SET_REFERENCE does not decode";
+            return BAD_FRAME;
+        }
+        uint8_t ok = (body[0] == CONSTANT && count == 1) || (body[0] == SINUSOID && count == 3) ||
+                     (body[0] == STEPS && count >= 2 && count <= MAX_LEVELS + 1);
+        if (!ok) {
+            *why = "the PneuNet rig runs a constant, steps or sinusoid program";
+            return BAD_VALUE;
+        }
+        for (uint8_t k = 0; k < count; k++) values[k] = read_float(body, (uint8_t)(2 + 4 * k));
+        if (body[0] == STEPS && !(values[0] > 0.0f)) {
+            *why = "SET_REFERENCE: the hold time must be > 0";
+            return BAD_VALUE;
+        }
+        shape = body[0], levels = (uint8_t)(count - 1);
+        return 0;
+    }
+    if (kind == SET_OUTPUT) {
+        float value = length == 5 ? read_float(body, 1) : -1.0f;
+        if (length != 5 || body[0] != 0 || !(value >= 0.0f && value <= 255.0f)) {
+            *why = "SET_OUTPUT: channel 0 takes a PWM count in 0-255";
+            return BAD_VALUE;
+        }
+        open_loop = value;
+        return 0;
+    }
+    *why = "the PneuNet rig does not take this command";
+    return UNKNOWN;
+}
+
+static uint8_t start(float duration, const char **why) {
+    float periods = duration * RATE_HZ;
+    if (!(periods >= 0.5f && periods < 4.0e9f)) {
+        *why = "the run's duration must be > 0";
+        return BAD_VALUE;
+    }
+    steps = (uint32_t)lroundf(periods);
+    n = 0;
+    integral = last_error = 0.0f;
+    OCR1A = 0;
+    PORTH |= _BV(PH5); /* the pump */
+    TCNT1 = 0;
+    TIFR1 = _BV(TOV1);
+    TIMSK1 = _BV(TOIE1);
+    return 0;
+}
+
+static void stop(void) {
+    TIMSK1 = 0;
+    OCR1A = 0;
+    PORTH &= (uint8_t)~_BV(PH5);
+    open_loop = -1.0f; /* SET_OUTPUT holds until STOP */
+}
+
+static const struct rig pneunet = {.kind = 1, .period_us = 33333, .channel_count = 3,
+                                   .channels = channels, .configure = configure,
+                                   .start = start, .stop = stop};
 
 int main(void) {
     uart_init();
-    struct command command;
-    uint8_t byte;
-    for (;;) {
-        if (!uart_read(&byte) || !frame_receive(byte, &command)) continue;
-        if (command.kind == HELLO) send_info();
-        else send_error(command.seq, UNKNOWN, "not in this firmware yet");
+    DDRB |= _BV(PB5); /* the valve: D11, OC1A */
+    DDRH |= _BV(PH5); /* the pump: D8 */
+    TCCR1A = _BV(COM1A1) | _BV(WGM11); /* fast PWM, TOP = ICR1 */
+    TCCR1B = _BV(WGM13) | _BV(WGM12) | _BV(CS11) | _BV(CS10); /* 16 MHz / 64 */
+    ICR1 = TICKS - 1;
+    ADMUX = _BV(REFS0); /* AVCC reference, A0 */
+    ADCSRA = _BV(ADEN) | _BV(ADPS2) | _BV(ADPS1) | _BV(ADPS0);
+    ADCSRA |= _BV(ADSC); /* the first, long conversion out of the way */
+    while (ADCSRA & _BV(ADSC)) {
     }
+    ADCSRA |= _BV(ADIE);
+    rig_serve(&pneunet);
 }

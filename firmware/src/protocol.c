@@ -2,6 +2,7 @@
 #include "protocol.h"
 
 #include <string.h>
+#include <util/crc16.h>
 
 #include "uart.h"
 
@@ -12,13 +13,10 @@ static uint8_t rx_overflow; /* more bytes than a frame holds before the delimite
 static uint8_t payload[MAX_FRAME];
 
 uint16_t crc16(const uint8_t *data, uint8_t length) {
-    uint16_t crc = 0xFFFF; /* CRC-16/CCITT-FALSE: polynomial 0x1021, no reflection */
-    for (uint8_t i = 0; i < length; i++) {
-        crc ^= (uint16_t)data[i] << 8;
-        for (uint8_t bit = 0; bit < 8; bit++) {
-            crc = (crc & 0x8000) ? (uint16_t)((crc << 1) ^ 0x1021) : (uint16_t)(crc << 1);
-        }
-    }
+    /* CRC-16/CCITT-FALSE is XMODEM's CRC (polynomial 0x1021, no reflection) started at
+     * 0xFFFF; avr-libc's update step is hand-written assembly. */
+    uint16_t crc = 0xFFFF;
+    for (uint8_t i = 0; i < length; i++) crc = _crc_xmodem_update(crc, data[i]);
     return crc;
 }
 
@@ -51,12 +49,12 @@ void frame_send(uint8_t kind, const uint8_t *body, uint8_t length) {
     uart_write(out, m);
 }
 
-/* The payload of a COBS block in rx, or 0 when it is malformed. */
+/* The payload of a COBS block in rx, or 0 when it is malformed or longer than a frame. */
 static uint8_t cobs_decode(void) {
     uint8_t i = 0, n = 0;
     while (i < rx_length) {
         uint8_t code = rx[i];
-        if (code == 0 || i + code > rx_length) return 0;
+        if (code == 0 || i + code > rx_length || n + code > sizeof payload) return 0;
         for (uint8_t k = 1; k < code; k++) payload[n++] = rx[i + k];
         i = (uint8_t)(i + code);
         if (code < 0xFF && i < rx_length) payload[n++] = 0;

@@ -9,6 +9,8 @@ from pathlib import Path
 
 import pytest
 
+from articula.rigs.firmware import FirmwareRig, PinPlant
+
 FIRMWARE = Path(__file__).resolve().parents[2] / "firmware"
 TOOLCHAIN = "apt-get install -y gcc-avr avr-libc simavr libsimavr-dev"
 
@@ -27,8 +29,8 @@ def built(tmp_path_factory) -> Path:
 
 @pytest.fixture
 def simavr(built) -> Iterator[Callable[[str], str]]:
-    """simavr(name) runs build/<name>.elf in the harness; its UART0's device path. Every
-    harness started is killed after the test."""
+    """simavr(name) runs build/<name>.elf in the harness without a plant; its UART0's device
+    path. Every harness started is killed after the test."""
     started: list[subprocess.Popen] = []
 
     def run(name: str) -> str:
@@ -45,3 +47,18 @@ def simavr(built) -> Iterator[Callable[[str], str]]:
     for proc in started:
         proc.kill()
         proc.wait(10)
+
+
+@pytest.fixture
+def on_plant(built) -> Iterator[Callable[[str, PinPlant], FirmwareRig]]:
+    """on_plant(name, plant): build/<name>.elf in the harness, its pins on `plant`; closed
+    after the test."""
+    rigs: list[FirmwareRig] = []
+
+    def run(name: str, plant: PinPlant) -> FirmwareRig:
+        rigs.append(FirmwareRig(built / f"{name}.elf", plant))
+        return rigs[-1]
+
+    yield run
+    for rig in rigs:
+        rig.close()

@@ -8,7 +8,7 @@ import math
 import pytest
 
 from articula.book.ch4.experiment import CurrentControlConfig, run_current_control
-from articula.book.ch4.rig import CHANNELS, emulated_motor, run_on_rig
+from articula.book.ch4.rig import DEVICE_CHANNELS, emulated_motor, run_on_rig
 from articula.book.study import packaged
 from articula.errors import DeviceError
 from articula.rigs.emulator import Emulator
@@ -30,7 +30,7 @@ def test_a_figures_run_on_the_emulated_rig_has_the_in_process_metrics(figure, tm
     config = figure_config(figure)
     emulator = Emulator(emulated_motor(config))
     with emulator, Link(emulator.path, RigKind.MOTOR) as link:
-        recorder = Recorder(tmp_path, {"experiment": "motor.current"}, CHANNELS)
+        recorder = Recorder(tmp_path, {"experiment": "motor.current"}, DEVICE_CHANNELS)
         on_rig = run_on_rig(config, link, recorder)
         assert link.stats.dropped == link.stats.crc_errors == 0
     here = run_current_control(config).metrics
@@ -49,4 +49,4 @@ def test_bad_motor_gains_are_refused_by_the_rig(tmp_path):
         update={"kp": -1.0})})  # fmt: skip
     emulator = Emulator(emulated_motor(config))
     with emulator, Link(emulator.path) as link, pytest.raises(DeviceError, match="gains"):
-        run_on_rig(bad, link, Recorder(tmp_path, {"experiment": "motor.current"}, CHANNELS))
+        run_on_rig(bad, link, Recorder(tmp_path, {"experiment": "motor.current"}, DEVICE_CHANNELS))

@@ -47,38 +47,87 @@ def emulate(
             "encoder the emulated rig has (default: chapter 4's)."
         ),
     ] = None,
+    firmware: Annotated[
+        Path | None,
+        typer.Option(
+            help="Run this firmware ELF (firmware/build/<rig>.elf, `make -C firmware`) in the "
+            "simavr AVR emulator, its pins on the simulated plant, instead of the Python "
+            "device."
+        ),
+    ] = None,
 ) -> None:
     """Start a simulated rig behind a pseudo-terminal and print its device path.
 
-    Example: articula emulate pneunet --fast, then articula rig info <the path it prints>"""
+    Example: articula emulate motor --firmware firmware/build/motor.elf, then articula rig
+    info <the path it prints>"""
     from articula.errors import ConfigError
-    from articula.rigs.emulator import Emulator, Faults
-    from articula.rigs.pneunet import PneuNetDevice
-    from articula.rigs.six_chamber import SixChamberDevice
 
     if rig not in RIGS:
         raise ConfigError("RIG", f"no emulator for {rig!r}; choose one of {', '.join(RIGS)}")
-    if rig == "motor":
-        from articula.book.ch4.experiment import CurrentControlConfig
-        from articula.book.ch4.rig import emulated_motor
-        from articula.validation import load_toml, parse_model
-
-        data = {} if plant is None else load_toml(plant)
-        data.pop("experiment", None)
-        config = parse_model(CurrentControlConfig, data, str(plant or "defaults"))
-        device = emulated_motor(config)
-    elif plant is not None:
+    if plant is not None and rig != "motor":
         raise ConfigError("--plant", "only the motor rig takes a plant config")
+    if firmware is not None:
+        if faults:
+            raise ConfigError("--faults", "faults are injected by the Python device, not on "
+                              "firmware; leave out --firmware or --faults")  # fmt: skip
+        emulator = _firmware_rig(rig, firmware, plant, realtime)
     else:
-        device = PneuNetDevice() if rig == "pneunet" else SixChamberDevice()
-    emulator = Emulator(device, realtime, Faults.parse(faults), seed).start()
+        from articula.rigs.emulator import Emulator, Faults
+
+        emulator = Emulator(_device(rig, plant), realtime, Faults.parse(faults), seed).start()
     out.print(f"{rig} rig at {emulator.path} (Ctrl-C stops it)")
     try:
         threading.Event().wait()
     except KeyboardInterrupt:
         pass
     finally:
-        emulator.stop()
+        if firmware is not None:
+            emulator.close()
+        else:
+            emulator.stop()
+
+
+def _motor_config(plant: Path | None):
+    """The motor.current config of --plant (chapter 4's defaults without one)."""
+    from articula.book.ch4.experiment import CurrentControlConfig
+    from articula.validation import load_toml, parse_model
+
+    data = {} if plant is None else load_toml(plant)
+    data.pop("experiment", None)
+    return parse_model(CurrentControlConfig, data, str(plant or "defaults"))
+
+
+def _device(rig: str, plant: Path | None):
+    """The Python device of an emulated rig."""
+    if rig == "motor":
+        from articula.book.ch4.rig import emulated_motor
+
+        return emulated_motor(_motor_config(plant))
+    if rig == "pneunet":
+        from articula.rigs.pneunet import PneuNetDevice
+
+        return PneuNetDevice()
+    from articula.rigs.six_chamber import SixChamberDevice
+
+    return SixChamberDevice()
+
+
+def _firmware_rig(rig: str, elf: Path, plant: Path | None, realtime: bool):
+    """The rig's firmware in the AVR emulator on its simulated plant."""
+    from articula.errors import ConfigError
+    from articula.rigs.firmware import FirmwareRig
+
+    if rig == "motor":
+        from articula.book.ch4.rig import firmware_motor
+
+        pins = firmware_motor(_motor_config(plant))
+    elif rig == "pneunet":
+        from articula.rigs.pneunet import PneuNetPins
+
+        pins = PneuNetPins()
+    else:
+        raise ConfigError("--firmware", "the six-chamber rig has no firmware yet")
+    return FirmwareRig(elf, pins, realtime)
 
 
 @rig_app.command()
@@ -145,12 +194,12 @@ def run_(
     module, rig = RIG_RUNS[exp.name]
     driver = importlib.import_module(module)
     with claimed(out_dir, "run", force), Link(port, RigKind[rig]) as link:
-        recorder = Recorder(out_dir, config_to_dict(exp, cfg), driver.CHANNELS)
+        recorder = Recorder(out_dir, config_to_dict(exp, cfg), driver.channels(link.info))
         record = recorder.capture(lambda: driver.run_on_rig(cfg, link, recorder), link.stats)
     if as_json:
         emit_json(record)
         return
-    rows = [(k, f"{v:.6g}") for k, v in record["metrics"].items()]
+    rows = [(k, "n/a" if v is None else f"{v:.6g}") for k, v in record["metrics"].items()]
     print_table(f"{exp.name} on {port}", ("metric", "value"), rows)
     lost = record["link"]
     out.print(f"{record['samples']} samples; line: {lost['crc_errors']} damaged, "

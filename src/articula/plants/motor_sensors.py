@@ -44,6 +44,22 @@ class EncoderParams(StrictModel):
 
 
 @jit(error_model="numpy")
+def adc_code(
+    current: float,
+    noise: float,
+    sensitivity: float,
+    zero_voltage: float,
+    noise_sigma: float,
+    adc_bits: int,
+    adc_vref: float,
+) -> int:
+    """The ADC's code for the sensor's output at `current` [A]; `noise` is a standard normal."""
+    volts = zero_voltage + sensitivity * current + noise_sigma * noise
+    levels = 1 << adc_bits
+    return min(max(math.floor(volts / adc_vref * levels), 0), levels - 1)
+
+
+@jit(error_model="numpy")
 def read_current(
     current: float,
     noise: float,
@@ -54,9 +70,8 @@ def read_current(
     adc_vref: float,
 ) -> float:
     """Current [A] the firmware computes from one ADC sample; `noise` is a standard normal draw."""
-    volts = zero_voltage + sensitivity * current + noise_sigma * noise
+    code = adc_code(current, noise, sensitivity, zero_voltage, noise_sigma, adc_bits, adc_vref)
     levels = 1 << adc_bits
-    code = min(max(math.floor(volts / adc_vref * levels), 0), levels - 1)
     # Mid-step reconstruction: the firmware's estimate is unbiased for a dithered input.
     return ((code + 0.5) * adc_vref / levels - zero_voltage) / sensitivity
 

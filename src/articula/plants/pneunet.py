@@ -159,12 +159,18 @@ class PneuNetBatch:
         )
         self.valve = command + x0 * ev
 
+    def read_code(self, noise: np.ndarray) -> np.ndarray:
+        """The flex sensor's ADC code (adc_bits > 0): the divider's volts with noise, floored."""
+        p = self.params
+        volts = p.sensor_zero + p.sensor_gain * (self.theta + p.sensor_noise * noise)
+        lsb = p.adc_vref / 2**p.adc_bits
+        return np.minimum(np.maximum(np.floor(volts / lsb), 0), 2**p.adc_bits - 1)
+
     def read(self, noise: np.ndarray) -> np.ndarray:
         """Flex-sensor angle [rad] as the controller reads it: noise, 10-bit ADC, back to angle."""
         p = self.params
-        volts = p.sensor_zero + p.sensor_gain * (self.theta + p.sensor_noise * noise)
         if p.adc_bits:
-            lsb = p.adc_vref / 2**p.adc_bits
-            counts = np.minimum(np.maximum(np.floor(volts / lsb), 0), 2**p.adc_bits - 1)
-            volts = (counts + 0.5) * lsb  # mid-step reconstruction
+            volts = (self.read_code(noise) + 0.5) * (p.adc_vref / 2**p.adc_bits)  # mid-step
+        else:
+            volts = p.sensor_zero + p.sensor_gain * (self.theta + p.sensor_noise * noise)
         return (volts - p.sensor_zero) / p.sensor_gain

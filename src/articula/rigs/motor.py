@@ -17,7 +17,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from articula.errors import DeviceError
+from articula.plants.motor_rig import I_PRIMARY, OMEGA, THETA
+from articula.plants.motor_sensors import CurrentSensorParams, adc_code, encoder_count
 from articula.rigs.emulator import PlayedRun
+from articula.rigs.firmware import Pins
 from articula.rigs.programs import Program, Shape
 from articula.rigs.protocol import PROTOCOL_VERSION, Channel, Info, Kind, RigKind
 
@@ -86,3 +89,65 @@ class MotorDevice(PlayedRun):
         if not duration > 0:
             raise DeviceError(f"the run's duration must be > 0 (got {duration:g} s)")
         self._begin(lambda: self.plant(self.gains, self.reference, duration, seed))
+
+
+# The firmware's H-bridge pins (firmware/src/motor.c): IN1/IN2 on PA2/PA3 for the primary,
+# IN3/IN4 on PA4/PA5 for the load motor; forward is the first of each pair high.
+DIRECTION_BITS = (2, 4)
+NOISE_CHUNK = 4096  # standard normals drawn at a time (the same stream as drawn at once)
+
+
+class MotorPins:
+    """The dual-motor rig's plant behind the firmware's pins (rigs/firmware.py).
+
+    Each control period the duty registers (OCR3A, OCR4A, 8-bit) and the direction pins give
+    the voltages the rig model integrates over the period (exact zero-order hold, as
+    loops.motor_current does); the ACS712's output is read as the 10-bit ADC's code, with the
+    sensor noise drawn from the run's seed as simulate_batch draws it; the encoder's count
+    is that of the shaft angle. `trace` keeps the true (i, ω) [A, rad/s] per period.
+    """
+
+    def __init__(
+        self,
+        Ad: np.ndarray,
+        Bd: np.ndarray,
+        sensor: CurrentSensorParams,
+        counts_per_rev: int,
+        v_max: float,
+    ) -> None:
+        self.Ad, self.Bd, self.sensor = Ad, Bd, sensor
+        self.counts_per_rev, self.v_max = counts_per_rev, v_max
+        self.trace: list[tuple[float, float]] = []
+        # The sensor's compiled code loads (or compiles) now, not while the firmware waits.
+        self.start(0)
+        self.period(Pins(1, 0, 0, 0, 0, 0, 0, 0))
+        self.start(0)
+
+    def start(self, seed: int) -> None:
+        """A run from rest; sensor noise from default_rng(seed) in order."""
+        self.x = np.zeros(self.Ad.shape[0])
+        self._rng = np.random.default_rng(seed)
+        self._noise = np.empty(0)
+        self._n = 0
+        self.trace = []
+
+    def period(self, pins: Pins) -> tuple[int, int]:
+        """The outputs held over the last period act; (ADC code, encoder count) now."""
+        if self._n > 0:
+            volts = [self._voltage(duty, pins.porta, bit) for duty, bit in
+                     zip((pins.ocr3a, pins.ocr4a), DIRECTION_BITS, strict=True)]  # fmt: skip
+            self.x = self.Ad @ self.x + self.Bd @ np.array(volts)
+        if self._n % NOISE_CHUNK == 0:
+            self._noise = self._rng.standard_normal(NOISE_CHUNK)
+        s = self.sensor
+        i, omega, theta = self.x[I_PRIMARY], self.x[OMEGA], self.x[THETA]
+        code = adc_code(i, self._noise[self._n % NOISE_CHUNK], s.sensitivity, s.zero_voltage,
+                        s.noise_sigma, s.adc_bits, s.adc_vref)  # fmt: skip
+        self._n += 1
+        self.trace.append((float(i), float(omega)))
+        return int(code), int(encoder_count(theta, self.counts_per_rev))
+
+    def _voltage(self, duty: int, porta: int, bit: int) -> float:
+        """The H-bridge's mean voltage [V] for a duty count and its direction pins."""
+        sign = {1: 1.0, 2: -1.0}.get((porta >> bit) & 3, 0.0)
+        return sign * self.v_max * (duty & 0xFF) / 256

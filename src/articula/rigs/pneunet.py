@@ -18,6 +18,7 @@ import numpy as np
 from articula.control.pid import PID, GainSchedule
 from articula.errors import ConfigError, DeviceError
 from articula.plants.pneunet import PneuNetBatch, PneuNetParams
+from articula.rigs.firmware import Pins
 from articula.rigs.link import Link
 from articula.rigs.programs import Program, Shape
 from articula.rigs.protocol import (
@@ -132,3 +133,42 @@ class PneuNetRig:
         t, values = run_program(self.link, self.duration, self.seed + self.calls)
         self.calls += 1
         return Response(t, values[:, 0], values[:, 1])
+
+
+# The firmware's valve and pump (firmware/src/pneunet.c): Timer1's PWM on D11 with 8333 ticks
+# a period, the pump on D8 (PH5). What it is built for: PneuNetParams' defaults below.
+VALVE_TICKS = 8333
+PUMP_BIT = 5
+FIRMWARE_BUILD = ("pwm_period", "sensor_zero", "sensor_gain", "adc_bits", "adc_vref")
+
+
+class PneuNetPins:
+    """The PneuNet's plant behind the firmware's pins (rigs/firmware.py): each PWM period the
+    valve's duty (OCR1A of Timer1's period, the pump on) drives the actuator model, and the
+    flex sensor is read as the 10-bit ADC's code, its noise drawn from the run's seed as
+    PneuNetDevice draws it."""
+
+    def __init__(self, params: PneuNetParams | None = None) -> None:
+        self.params = params or PneuNetParams()
+        built = PneuNetParams()
+        for name in FIRMWARE_BUILD:
+            if getattr(self.params, name) != getattr(built, name):
+                raise ConfigError(f"plant.{name}", f"the PneuNet firmware is built for "
+                                  f"{getattr(built, name):g}; change the config or "
+                                  "firmware/src/pneunet.c")  # fmt: skip
+        self.start(0)
+
+    def start(self, seed: int) -> None:
+        """A run from rest; the sensor's noise from the first of SeedSequence(seed)'s streams."""
+        noise_seed, _ = np.random.SeedSequence(seed).spawn(2)
+        self._rng = np.random.default_rng(noise_seed)
+        self._plant = PneuNetBatch(self.params, 1, None)
+        self._n = 0
+
+    def period(self, pins: Pins) -> tuple[int, int]:
+        """The last period's duty acts; (the flex sensor's ADC code, 0) now."""
+        if self._n > 0:
+            pump = pins.porth >> PUMP_BIT & 1
+            self._plant.advance(np.array([pump * min(pins.ocr1a, VALVE_TICKS) / VALVE_TICKS]))
+        self._n += 1
+        return int(self._plant.read_code(self._rng.standard_normal(1))[0]), 0

@@ -25,7 +25,7 @@ def run_program(
     sees each sample as it arrives (a Recorder's add)."""
     channels = len(link.info.channels)
     link.command(Kind.STREAM, struct.pack("<H", 1))
-    start = link.command(Kind.START, struct.pack("<fI", duration, seed & 0xFFFFFFFF))
+    start = link.command(Kind.START, struct.pack("<fI", duration, seed & 0xFFFFFFFF), fresh=True)
     times, rows = [], []
     while True:
         frame = link.next_frame(QUIET)

@@ -22,7 +22,7 @@ from articula.errors import ConfigError
 from articula.rigs.link import Link
 from articula.rigs.pneunet import PneuNetRig, encode_gains
 from articula.rigs.programs import Program, Shape, steps
-from articula.rigs.protocol import Kind
+from articula.rigs.protocol import Info, Kind
 from articula.rigs.recorder import Recorder
 from articula.rigs.run import run_program
 from articula.tuning.manual import (
@@ -35,6 +35,11 @@ from articula.tuning.manual import (
 from articula.tuning.response import Response, tracking_error, tuning_cost
 
 CHANNELS = ("trial", "theta_ref_deg", "theta_meas_deg", "pwm")  # the recorder's columns
+
+
+def channels(info: Info) -> tuple[str, ...]:
+    """The recorder's columns for the rig that `info` describes."""
+    return CHANNELS
 
 
 def reference_program(reference: AngleReference, duration: float) -> Program:

@@ -14,12 +14,17 @@ from articula.book.ch3.experiment import DeactuationConfig, oscillation_metrics
 from articula.control.chamber_allocation import bend_direction
 from articula.rigs.link import Link
 from articula.rigs.programs import Program, Shape
-from articula.rigs.protocol import Kind
+from articula.rigs.protocol import Info, Kind
 from articula.rigs.recorder import Recorder
 from articula.rigs.run import run_program
 from articula.rigs.six_chamber import encode_damping
 
 CHANNELS = ("bend_x_deg", "bend_y_deg")  # the recorder's columns
+
+
+def channels(info: Info) -> tuple[str, ...]:
+    """The recorder's columns for the rig that `info` describes."""
+    return CHANNELS
 
 
 def run_on_rig(config: DeactuationConfig, link: Link, recorder: Recorder) -> dict[str, float]:

@@ -23,14 +23,22 @@ from articula.book.ch4.experiment import (
 )
 from articula.control.moving_average import moving_average
 from articula.control.pwm import pwm_voltage
+from articula.errors import ConfigError
+from articula.plants.dc_motor import PRESETS
+from articula.plants.motor_rig import discretize, rig_matrices
 from articula.rigs.link import Link
-from articula.rigs.motor import EMULATED, MEASURED, MotorDevice, MotorGains
+from articula.rigs.motor import EMULATED, MEASURED, MotorDevice, MotorGains, MotorPins
 from articula.rigs.programs import Program, Shape
-from articula.rigs.protocol import Kind
+from articula.rigs.protocol import Info, Kind
 from articula.rigs.recorder import Recorder
 from articula.rigs.run import run_program
 
-CHANNELS = tuple(c.name for c in MEASURED + EMULATED)
+DEVICE_CHANNELS = tuple(c.name for c in MEASURED + EMULATED)  # the emulated device's
+
+
+def channels(info: Info) -> tuple[str, ...]:
+    """The recorder's columns: what the rig sends (firmware: the measured channels only)."""
+    return tuple(c.name for c in info.channels)
 
 
 def emulated_motor(config: CurrentControlConfig) -> MotorDevice:
@@ -49,9 +57,39 @@ def emulated_motor(config: CurrentControlConfig) -> MotorDevice:
                                           frequency=frequency, speed=speed),
         })  # fmt: skip
         channels, _ = simulate_batch(run, trials=1)
-        return np.column_stack([channels[name][0] for name in CHANNELS])
+        return np.column_stack([channels[name][0] for name in DEVICE_CHANNELS])
 
     return MotorDevice(plant, config.dt)
+
+
+# What firmware/src/motor.c is built for: its loop period, H-bridge, sensor and encoder.
+FIRMWARE_BUILD = {
+    "dt": 0.001,
+    "pwm.bits": 8,
+    "pwm.v_max": 12.0,
+    "sensor.ideal": False,
+    "encoder.ideal": False,
+    "encoder.counts_per_rev": 375,
+    "encoder.window": 50,
+}
+
+
+def firmware_motor(config: CurrentControlConfig) -> MotorPins:
+    """The plant behind the motor firmware's pins: `config`'s rig and motor, with the
+    loop period, PWM, sensor and encoder the firmware is built for (ConfigError otherwise);
+    the firmware computes its feed-forward (4.13) with Table 4.2's R and K."""
+    for name, built in FIRMWARE_BUILD.items():
+        value = config
+        for part in name.split("."):
+            value = getattr(value, part)
+        if value != built:
+            raise ConfigError(name, f"the motor firmware is built for {built} (got {value}); "
+                              "change the config or firmware/src/motor.c")  # fmt: skip
+    motor = config.motor or PRESETS[config.preset]
+    Ad, Bd = discretize(*rig_matrices(motor, config.rig == "dual"), config.dt)
+    if Ad.shape[0] == 3:  # the single rig: no secondary current, V2 acts on nothing
+        Ad, Bd = np.pad(Ad, (0, 1)), np.pad(Bd, ((0, 1), (0, 0)))
+    return MotorPins(Ad, Bd, config.sensor, config.encoder.counts_per_rev, config.pwm.v_max)
 
 
 def run_on_rig(config: CurrentControlConfig, link: Link, recorder: Recorder) -> dict[str, float]:

@@ -1,0 +1,113 @@
+"""A rig's own firmware (firmware/, C for the ATmega2560) run in the simavr harness, its pins
+coupled in lock step to the simulated plant: `articula emulate RIG --firmware ELF`.
+
+The harness (firmware/harness/harness.c) runs the ELF cycle by cycle and puts its UART0
+behind a pseudo-terminal, the path the host opens. Every ADC conversion the firmware starts
+is one control period of the plant: the harness reports the output registers the firmware
+left (port and PWM compare registers) and takes back the ADC code the conversion reads and
+the count the quadrature encoder reaches. The plant is the Python model of the in-process
+simulation (a `PinPlant`), advanced one control period per exchange; it starts from rest
+with the run's seed when the firmware starts a run.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import subprocess
+import threading
+from pathlib import Path
+from typing import NamedTuple, Protocol
+
+from articula.errors import ConfigError, DeviceError
+
+BUILD_HINT = "build it with: make -C firmware (needs apt-get install -y gcc-avr avr-libc " \
+    "simavr libsimavr-dev)"  # fmt: skip
+
+
+class Pins(NamedTuple):
+    """The firmware's outputs at the start of a control period, as the harness reads them."""
+
+    adc_channel: int  # the channel the starting conversion reads
+    porta: int  # port registers: direction and valve pins
+    portc: int
+    porth: int
+    ocr1a: int  # PWM compare registers (duty counts)
+    ocr3a: int
+    ocr4a: int
+    step_cycles: int  # CPU cycles the previous control step took
+
+
+class PinPlant(Protocol):
+    """A simulated plant behind the firmware's pins."""
+
+    def start(self, seed: int) -> None:
+        """A run starts: the plant at rest, its noise drawn from `seed`."""
+
+    def period(self, pins: Pins) -> tuple[int, int]:
+        """One control period: the outputs `pins` held since the last call act on the plant
+        (none before the first); returns (ADC code, encoder count) at the period's start."""
+
+
+class FirmwareRig:
+    """A firmware ELF in the harness with its plant; `path` is the port the host opens.
+
+    Args:
+        elf: the firmware (firmware/build/<rig>.elf); the harness is found beside it.
+        plant: the simulated plant its pins drive and read.
+        realtime: keep the wall clock's pace during runs (default: as fast as it goes).
+    """
+
+    def __init__(self, elf: Path, plant: PinPlant, realtime: bool = False) -> None:
+        elf = Path(elf)
+        harness = elf.parent / "harness"
+        for what in (elf, harness):
+            if not what.is_file():
+                raise ConfigError("--firmware", f"{what} does not exist; {BUILD_HINT}")
+        self.plant = plant
+        self.step_cycles: list[int] = []  # per control period of the last run
+        args = [str(harness), str(elf), "--plant"] + (["--realtime"] if realtime else [])
+        self._proc = subprocess.Popen(args, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                      text=True, bufsize=1)  # fmt: skip
+        self.path = self._read_path()
+        self._thread = threading.Thread(target=self._serve, name="articula-plant", daemon=True)
+        self._thread.start()
+
+    def _read_path(self) -> str:
+        """The harness's first words: where its UART0 is."""
+        for line in self._proc.stdout:
+            if line.startswith("uart0 at "):
+                return line.split()[-1]
+        code = self._proc.wait()
+        raise DeviceError(f"the firmware harness ended before its UART came up (exit {code})")
+
+    def _serve(self) -> None:
+        """Answer the harness's periods until it ends."""
+        for line in self._proc.stdout:
+            word, *numbers = line.split()
+            if word == "run":
+                self.plant.start(int(numbers[0]))
+                self.step_cycles = []
+            elif word == "sample":
+                pins = Pins(*map(int, numbers))
+                self.step_cycles.append(pins.step_cycles)
+                code, count = self.plant.period(pins)
+                try:
+                    self._proc.stdin.write(f"{code} {count}\n")
+                    self._proc.stdin.flush()
+                except (BrokenPipeError, ValueError):
+                    return  # the harness is gone
+
+    def close(self) -> None:
+        """Stop the harness (the port goes away)."""
+        self._proc.kill()
+        self._proc.wait()
+        self._thread.join(timeout=2.0)
+        for stream in (self._proc.stdin, self._proc.stdout):
+            with contextlib.suppress(BrokenPipeError, OSError):
+                stream.close()
+
+    def __enter__(self) -> FirmwareRig:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
