@@ -87,10 +87,12 @@ class Link:
 
     def command(self, kind: Kind, body: bytes = b"", fresh: bool = False) -> int:
         """Send one command and wait for its acknowledgement (resent on silence); returns
-        the command's sequence number (a DONE names its START by it). `fresh`: forget the
-        device frames that came before the acknowledgement (a run's START: they belong to
-        an earlier run)."""
-        self._exchange(kind, body, answer=Kind.ACK, fresh=fresh)
+        the command's sequence number (a DONE names its START by it). `fresh`: first forget
+        the device frames taken in and not asked for (a run's START: they belong to an
+        earlier run)."""
+        if fresh:
+            self.inbox.clear()
+        self._exchange(kind, body, answer=Kind.ACK)
         return self._seq
 
     def status(self) -> tuple[bool, int]:
@@ -119,7 +121,7 @@ class Link:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def _exchange(self, kind: Kind, body: bytes, answer: Kind, fresh: bool = False) -> Frame:
+    def _exchange(self, kind: Kind, body: bytes, answer: Kind) -> Frame:
         """Send (kind, body) until `answer` naming it comes back; the answer frame."""
         seq = self._seq = (self._seq + 1) & 0xFFFF
         wire = protocol.encode(kind, seq, body)
@@ -129,22 +131,19 @@ class Link:
             self._write(wire)
             deadline = time.monotonic() + self.timeout
             while time.monotonic() < deadline:
-                reply = self._take_reply(seq, answer, fresh)
+                reply = self._take_reply(seq, answer)
                 if reply is not None:
                     return reply
                 self._read()
         raise DeviceError(f"{self.port}: no answer to {kind.name} after {self.retries + 1} "
                           f"tries; is the rig on and running articula's firmware?")  # fmt: skip
 
-    def _take_reply(self, seq: int, answer: Kind, fresh: bool = False) -> Frame | None:
-        """The inbox's answer to command `seq` (removed, and with `fresh` every frame before
-        it), if it is there; an ERROR naming it raises DeviceError."""
-        for at, frame in enumerate(list(self.inbox)):
+    def _take_reply(self, seq: int, answer: Kind) -> Frame | None:
+        """The inbox's answer to command `seq` (removed), if it is there; an ERROR naming it
+        raises DeviceError."""
+        for frame in list(self.inbox):
             if frame.kind == answer and (answer == Kind.INFO or _acked(frame) == seq):
-                for _ in range(at + 1 if fresh else 0):
-                    self.inbox.popleft()
-                if not fresh:
-                    self.inbox.remove(frame)
+                self.inbox.remove(frame)
                 return frame
             if frame.kind == Kind.ERROR and _acked(frame) == seq:
                 self.inbox.remove(frame)
