@@ -101,6 +101,7 @@ ISR(TIMER1_COMPA_vect) {
 }
 
 ISR(ADC_vect) {
+    if (n >= steps) return; /* at rest (the first conversion after reset) */
     probe_busy();
     uint16_t code = ADC;
     /* (4.17) as a mean over `order` samples, those before the run counting as 0 A: the sum
@@ -255,14 +256,11 @@ int main(void) {
     TCCR3B = _BV(WGM32) | _BV(CS30);
     TCCR4A = _BV(COM4A1) | _BV(WGM40);
     TCCR4B = _BV(WGM42) | _BV(CS40);
+    OCR1A = TICKS - 1; /* TOP first: the timer starts with its clock (simavr reads TOP then) */
     TCCR1B = _BV(WGM12) | _BV(CS10); /* CTC: the 1 kHz control tick */
-    OCR1A = TICKS - 1;
     ADMUX = _BV(REFS0) | 1;                                /* AVCC reference, A1 */
     ADCSRA = _BV(ADEN) | _BV(ADPS2) | _BV(ADPS1) | _BV(ADPS0); /* 125 kHz ADC clock */
-    ADCSRA |= _BV(ADSC); /* the first conversion is the long one: out of the way now */
-    while (ADCSRA & _BV(ADSC)) {
-    }
-    ADCSRA |= _BV(ADIE);
+    ADCSRA |= _BV(ADIE) | _BV(ADSC); /* the first, long conversion now (ignored at rest) */
     EICRB = _BV(ISC40) | _BV(ISC50); /* D2/D3 (INT4/INT5): any edge */
     EIMSK = _BV(INT4) | _BV(INT5);
     rig_serve(&motor);

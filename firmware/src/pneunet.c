@@ -76,6 +76,7 @@ ISR(TIMER1_OVF_vect) {
 }
 
 ISR(ADC_vect) {
+    if (n >= steps) return; /* at rest (the first conversion after reset) */
     probe_busy();
     uint16_t code = ADC;
     const float deg_per_code = ADC_VREF / 1024.0f / SENSOR_GAIN * DEG_PER_RAD;
@@ -198,14 +199,11 @@ int main(void) {
     uart_init();
     DDRB |= _BV(PB5); /* the valve: D11, OC1A */
     DDRH |= _BV(PH5); /* the pump: D8 */
+    ICR1 = TICKS - 1; /* TOP first: the timer starts with its clock (simavr reads TOP then) */
     TCCR1A = _BV(COM1A1) | _BV(WGM11); /* fast PWM, TOP = ICR1 */
     TCCR1B = _BV(WGM13) | _BV(WGM12) | _BV(CS11) | _BV(CS10); /* 16 MHz / 64 */
-    ICR1 = TICKS - 1;
     ADMUX = _BV(REFS0); /* AVCC reference, A0 */
     ADCSRA = _BV(ADEN) | _BV(ADPS2) | _BV(ADPS1) | _BV(ADPS0);
-    ADCSRA |= _BV(ADSC); /* the first, long conversion out of the way */
-    while (ADCSRA & _BV(ADSC)) {
-    }
-    ADCSRA |= _BV(ADIE);
+    ADCSRA |= _BV(ADIE) | _BV(ADSC); /* the first, long conversion now (ignored at rest) */
     rig_serve(&pneunet);
 }

@@ -32,14 +32,14 @@ def test_the_handshakes_are_byte_for_byte_the_python_rigs(simavr):
 
 def test_commands_a_rig_does_not_take_or_values_out_of_range_are_refused_by_name(simavr):
     with Link(simavr("pneunet")) as link:
-        with pytest.raises(DeviceError, match="does not take.*code 2"):
+        with pytest.raises(DeviceError, match=r"does not take.*code 2"):
             link.command(Kind.SET_DAMPING, struct.pack("<fff", 0.4, 0.0, 0.0))
-        with pytest.raises(DeviceError, match="0-255.*code 3"):
+        with pytest.raises(DeviceError, match=r"0-255.*code 3"):
             link.command(Kind.SET_OUTPUT, struct.pack("<Bf", 0, 300.0))
     with Link(simavr("motor")) as link:
-        with pytest.raises(DeviceError, match="filter order 1-100.*code 3"):
+        with pytest.raises(DeviceError, match=r"filter order 1-100.*code 3"):
             link.command(Kind.SET_GAINS, MotorGains(filter_order=101).encode())
-        with pytest.raises(DeviceError, match="5 reals.*code 1"):
+        with pytest.raises(DeviceError, match=r"5 reals.*code 1"):
             link.command(Kind.SET_GAINS, b"\0" * 8)
 
 
@@ -49,12 +49,12 @@ def test_a_run_reports_its_samples_refuses_settings_and_stops_on_stop(simavr):
         time.sleep(0.3)
         running, samples = link.status()
         assert running and samples > 0
-        with pytest.raises(DeviceError, match="at rest.*code 4"):
+        with pytest.raises(DeviceError, match=r"at rest.*code 4"):
             link.command(Kind.SET_GAINS, MotorGains().encode())
-        with pytest.raises(DeviceError, match="STOP it first.*code 4"):
+        with pytest.raises(DeviceError, match=r"STOP it first.*code 4"):
             link.command(Kind.START, struct.pack("<fI", 1.0, 0))
         link.command(Kind.STOP)
-        running, stopped_at = link.status()
+        running, _ = link.status()
         assert not running
         t, rows = run_program(link, 0.05, 0)  # the next run is whole, from sample 0
         assert len(t) == 50 and t[0] == 0.0 and rows.shape == (50, len(MEASURED))
