@@ -235,7 +235,7 @@ static void sleep_callback(avr_t *a, avr_cycle_count_t how_long) {
 }
 
 int main(int argc, char **argv) {
-    elf_firmware_t firmware = {{0}};
+    static elf_firmware_t firmware; /* zeroed */
     for (int i = 2; i < argc; i++) {
         if (!strcmp(argv[i], "--plant")) plant = 1;
         else if (!strcmp(argv[i], "--realtime")) realtime = 1;
