@@ -41,7 +41,7 @@ from articula.rigs.recorder import Recorder
 from articula.validation import load_toml, parse_model
 
 FIRMWARE = Path(__file__).resolve().parents[1] / "firmware"
-PROGRAMS = ("motor", "pneunet")
+PROGRAMS = ("motor", "pneunet", "six_chamber")
 FIGURES = ("fig4_5", "fig4_6", "fig4_7", "fig4_8", "fig4_9")
 RAM = 8192  # [bytes] the ATmega2560's SRAM
 MOTOR_PERIOD_CYCLES = 16_000
@@ -121,5 +121,5 @@ def table(m: dict[str, Any]) -> tuple[str, list[str], list[list[str]]]:
 
 
 if __name__ == "__main__":
-    run(__doc__, measure, table,
-        build={"type": str, "default": None, "help": "build folder (default: a temporary one)"})  # fmt: skip
+    build = {"type": str, "default": None, "help": "build folder (default: temporary)"}
+    run(__doc__, measure, table, build=build)

@@ -1,7 +1,7 @@
 /* Runs a rig's firmware ELF on a simulated ATmega2560 at 16 MHz (simavr), UART0 behind a
  * pseudo-terminal, and couples its pins to a simulated plant in lock step.
  *
- *   harness FIRMWARE.elf [--plant] [--realtime]
+ *   harness FIRMWARE.elf [--plant] [--tick-us N] [--realtime]
  *
  * Prints "uart0 at <device path>", then runs until killed (or, with --plant, until its
  * standard input closes). The host opens that path as it would open /dev/ttyACM0.
@@ -11,9 +11,12 @@
  * writes
  *     sample <adc channel> <PORTA> <PORTC> <PORTH> <OCR1A> <OCR3A> <OCR4A> <step cycles>
  * (the output registers as the firmware left them, and the CPU cycles of the previous control
- * step) and waits for "<adc code> <encoder count>": the code the conversion reads and the
- * count the quadrature encoder on D2/D3 (PE4/PE5) reaches, one edge every EDGE_CYCLES. A run
- * starting (the firmware's probe, probe.h) is "run <seed>"; its end "end".
+ * step) and waits for "<adc code> <encoder count> [<hex bytes>]": the code the conversion
+ * reads, the count the quadrature encoder on D2/D3 (PE4/PE5) reaches, one edge every
+ * EDGE_CYCLES, and bytes a sensor sends on Serial1 (RX1, at 115 200 baud). With --tick-us
+ * the plant has its own step instead: an exchange every N µs of a run (adc channel 255),
+ * from N µs after its start. A run starting (the firmware's probe, probe.h) is
+ * "run <seed>"; its end "end".
  *
  * Time: during a run the simulation runs as fast as the plant answers (--realtime: at the
  * wall clock's pace); at rest it keeps the wall clock's pace, so an idle rig costs little. */
@@ -52,6 +55,8 @@
 #define POLL_CYCLES 1600     /* the pty is served every 100 µs of simulated time */
 #define EDGE_CYCLES 64       /* between the encoder's edges */
 #define BYTE_CYCLES 160      /* a byte's time on the line at 1 Mbaud */
+#define SENSOR_BYTE_CYCLES 1389 /* at 115 200 baud */
+#define NO_CONVERSION 255
 #define QUEUE 65536          /* bytes each way between the pty and the UART */
 #define OUT_HIGH_WATER 4096  /* the simulation waits for the host above this */
 #define VCC_MV 5000
@@ -63,12 +68,13 @@ struct queue {
 
 static avr_t *avr;
 static int master = -1;
-static struct queue to_avr, to_host;
+static struct queue to_avr, to_host, to_sensor_rx;
 static int xon = 1;
 static int plant, realtime, running;
 static uint32_t seed;
 static uint8_t seed_bytes;
-static avr_irq_t *uart_in, *adc_in, *encoder_pin[2];
+static avr_irq_t *uart_in, *sensor_in, *adc_in, *encoder_pin[2];
+static avr_cycle_count_t tick_cycles; /* the plant's own step (--tick-us); 0: per conversion */
 static int32_t encoder_count, encoder_target;
 static uint8_t encoder_phase; /* the pins' state in the Gray sequence 00, 10, 11, 01 */
 static avr_cycle_count_t step_cycles, entered[64];
@@ -147,28 +153,62 @@ static avr_cycle_count_t encoder_edge(avr_t *a, avr_cycle_count_t when, void *pa
 
 static uint16_t reg16(uint16_t low) { return (uint16_t)(avr->data[low] | (avr->data[low + 1] << 8)); }
 
-/* A conversion starts: one control period of the plant. */
-static void adc_trigger(avr_irq_t *irq, uint32_t value, void *param) {
-    (void)irq, (void)param;
-    if (!running) return; /* at rest the plant does not move: the last reading stands */
-    union {
-        avr_adc_mux_t mux;
-        uint32_t value;
-    } e = {.value = value};
-    printf("sample %u %u %u %u %u %u %u %llu\n", e.mux.src, avr->data[PORTA], avr->data[PORTC],
+/* The sensor's next byte onto Serial1. */
+static avr_cycle_count_t sensor_feed(avr_t *a, avr_cycle_count_t when, void *param) {
+    (void)a, (void)param;
+    if (!queue_size(&to_sensor_rx)) return 0;
+    avr_raise_irq(sensor_in, to_sensor_rx.data[to_sensor_rx.tail++ % QUEUE]);
+    return when + SENSOR_BYTE_CYCLES;
+}
+
+/* One control period of the plant: the outputs the firmware left, then what it answers. */
+static void exchange(unsigned channel) {
+    printf("sample %u %u %u %u %u %u %u %llu\n", channel, avr->data[PORTA], avr->data[PORTC],
            avr->data[PORTH], reg16(OCR1AL), reg16(OCR3AL), reg16(OCR4AL),
            (unsigned long long)step_cycles);
     fflush(stdout);
     step_cycles = 0;
+    static char line[4096];
     unsigned code;
     long count;
-    if (scanf("%u %ld", &code, &count) != 2) exit(0); /* the plant is gone */
-    /* simavr's ADC reads floor(mV · 1023 / VCC): the smallest mV that reads `code`. */
-    uint32_t mv = (uint32_t)((code * VCC_MV + 1022) / 1023);
-    avr_raise_irq(adc_in + e.mux.src, mv);
+    int used = 0;
+    if (!fgets(line, sizeof line, stdin)) exit(0); /* the plant is gone */
+    if (sscanf(line, "%u %ld %n", &code, &count, &used) < 2) {
+        fprintf(stderr, "harness: the plant answered %s", line);
+        exit(1);
+    }
+    if (channel < 8) {
+        /* simavr's ADC reads floor(mV · 1023 / VCC): the smallest mV that reads `code`. */
+        uint32_t mv = (uint32_t)((code * VCC_MV + 1022) / 1023);
+        avr_raise_irq(adc_in + channel, mv);
+    }
     encoder_target = (int32_t)count;
     avr_cycle_timer_cancel(avr, encoder_edge, NULL);
     if (encoder_target != encoder_count) avr_cycle_timer_register(avr, 1, encoder_edge, NULL);
+    unsigned byte;
+    for (char *at = line + used; sscanf(at, "%2x", &byte) == 1; at += 2)
+        to_sensor_rx.data[to_sensor_rx.head++ % QUEUE] = (uint8_t)byte;
+    if (queue_size(&to_sensor_rx) && !avr_cycle_timer_status(avr, sensor_feed, NULL))
+        avr_cycle_timer_register(avr, 1, sensor_feed, NULL);
+}
+
+/* A conversion starts: with a plant that steps per conversion, one control period. */
+static void adc_trigger(avr_irq_t *irq, uint32_t value, void *param) {
+    (void)irq, (void)param;
+    if (!running || tick_cycles) return; /* at rest the last reading stands */
+    union {
+        avr_adc_mux_t mux;
+        uint32_t value;
+    } e = {.value = value};
+    exchange(e.mux.src);
+}
+
+/* The plant's own step (--tick-us), through a run. */
+static avr_cycle_count_t plant_tick(avr_t *a, avr_cycle_count_t when, void *param) {
+    (void)a, (void)param;
+    if (!running) return 0;
+    exchange(NO_CONVERSION);
+    return when + tick_cycles;
 }
 
 /* An interrupt that marked itself part of the control step starts or ends (reti). */
@@ -182,8 +222,9 @@ static void vector_running(avr_irq_t *irq, uint32_t value, void *param) {
 static void probe(avr_t *a, avr_io_addr_t addr, uint8_t v, void *param) {
     (void)param;
     a->data[addr] = v;
-    if (addr == GPIOR1) {
-        seed = seed_bytes++ % 4 == 0 ? v : seed | (uint32_t)v << (8 * ((seed_bytes - 1) % 4));
+    if (addr == GPIOR1) { /* the seed, least significant byte first */
+        uint8_t k = seed_bytes++ % 4;
+        seed = k == 0 ? v : seed | (uint32_t)v << (8 * k);
         return;
     }
     if (v == PROBE_RUN) {
@@ -191,6 +232,11 @@ static void probe(avr_t *a, avr_io_addr_t addr, uint8_t v, void *param) {
         seed_bytes = 0;
         encoder_count = encoder_target = 0; /* the firmware counts from 0 at a run's start */
         if (plant) printf("run %u\n", seed), fflush(stdout);
+        to_sensor_rx.tail = to_sensor_rx.head; /* the sensor's line starts afresh */
+        if (plant && tick_cycles) {
+            avr_cycle_timer_cancel(a, plant_tick, NULL);
+            avr_cycle_timer_register(a, tick_cycles, plant_tick, NULL);
+        }
     } else if (v == PROBE_END) {
         running = 0;
         if (plant) printf("end\n"), fflush(stdout);
@@ -239,10 +285,12 @@ int main(int argc, char **argv) {
     for (int i = 2; i < argc; i++) {
         if (!strcmp(argv[i], "--plant")) plant = 1;
         else if (!strcmp(argv[i], "--realtime")) realtime = 1;
+        else if (!strcmp(argv[i], "--tick-us") && i + 1 < argc)
+            tick_cycles = 16u * (avr_cycle_count_t)strtoul(argv[++i], NULL, 10);
         else argc = 0;
     }
     if (argc < 2 || elf_read_firmware(argv[1], &firmware) != 0) {
-        fprintf(stderr, "usage: harness FIRMWARE.elf [--plant] [--realtime]\n");
+        fprintf(stderr, "usage: harness FIRMWARE.elf [--plant] [--tick-us N] [--realtime]\n");
         return 2;
     }
     avr = avr_make_mcu_by_name("atmega2560");
@@ -272,6 +320,7 @@ int main(int argc, char **argv) {
                                 adc_trigger, NULL);
         for (int k = 0; k < 2; k++)
             encoder_pin[k] = avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ('E'), 4 + k);
+        sensor_in = avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('1'), UART_IRQ_INPUT);
     }
 
     int slave;

@@ -99,12 +99,12 @@ static void start(const struct rig *rig, const struct command *c) {
         ring_tail = ring_head;
         samples = 0;
         finished = 0;
-        probe_run(seed);
         uint8_t code = rig->start(duration, &why);
         if (code) {
             send_error(c->seq, code, why);
             return;
         }
+        probe_run(seed); /* right after the control timer starts: the plant's time 0 */
         running = 1;
         run_seq = last_start = c->seq;
         have_last_start = 1;

@@ -21,7 +21,7 @@ def test_firmware_benchmark_prints_its_keys(built):
     m = json.loads(proc.stdout)
     assert 0 < m["motor_loop_cycles_max"] < 16_000
     assert m["motor_loop_budget_fraction"] == m["motor_loop_cycles_max"] / 16_000
-    for program in ("motor", "pneunet"):
+    for program in ("motor", "pneunet", "six_chamber"):
         assert 0 < m["flash_bytes"][program] < 256 * 1024
         assert 0 < m["ram_bytes"][program] < 8192
     assert m["firmware_run_s"] > 0 and m["simulation_run_s"] > 0

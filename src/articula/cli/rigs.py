@@ -114,7 +114,6 @@ def _device(rig: str, plant: Path | None):
 
 def _firmware_rig(rig: str, elf: Path, plant: Path | None, realtime: bool):
     """The rig's firmware in the AVR emulator on its simulated plant."""
-    from articula.errors import ConfigError
     from articula.rigs.firmware import FirmwareRig
 
     if rig == "motor":
@@ -126,7 +125,9 @@ def _firmware_rig(rig: str, elf: Path, plant: Path | None, realtime: bool):
 
         pins = PneuNetPins()
     else:
-        raise ConfigError("--firmware", "the six-chamber rig has no firmware yet")
+        from articula.rigs.six_chamber import SixChamberPins
+
+        pins = SixChamberPins()
     return FirmwareRig(elf, pins, realtime)
 
 

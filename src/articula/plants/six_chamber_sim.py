@@ -127,6 +127,28 @@ def integrate(
     return Simulation(t, y[:, 0:2], y[:, 2:4], y[:, 4:] - p.atmosphere, m)
 
 
+class Stepper:
+    """The actuator from rest advanced one RK4 step at a time with valve positions given
+    each step (a firmware's pins), exactly as `integrate` advances it between events."""
+
+    def __init__(self, p: SixChamberParams, dt: float = 1e-4) -> None:
+        self.p, self.dt = p, dt
+        self._c, self._a = _constants(p), volume_gradients(p)
+        self._none = (np.zeros(0), np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0))
+        self.y = np.concatenate([np.zeros(4), np.full(CHAMBERS, p.atmosphere)])
+
+    @property
+    def beta(self) -> np.ndarray:
+        """The bending vector β (2,) [rad]."""
+        return self.y[0:2]
+
+    def advance(self, modes: np.ndarray) -> None:
+        """One step dt with the valves at `modes` (6,) (VENT, HOLD or FILL)."""
+        _, ys, _ = _integrate(self.y, np.array(modes, np.int64), self._c, self._a, *self._none,
+                              self.dt, 1, 1)  # fmt: skip
+        self.y = ys[-1]
+
+
 @jit(error_model="numpy")
 def orifice_flow(upstream: float, downstream: float, rt: float, cda: float, trans: float) -> float:
     """Mass flow [kg/s] through an orifice, sharp-edged above `trans` [Pa], linear below."""

@@ -4,10 +4,12 @@ coupled in lock step to the simulated plant: `articula emulate RIG --firmware EL
 The harness (firmware/harness/harness.c) runs the ELF cycle by cycle and puts its UART0
 behind a pseudo-terminal, the path the host opens. Every ADC conversion the firmware starts
 is one control period of the plant: the harness reports the output registers the firmware
-left (port and PWM compare registers) and takes back the ADC code the conversion reads and
-the count the quadrature encoder reaches. The plant is the Python model of the in-process
-simulation (a `PinPlant`), advanced one control period per exchange; it starts from rest
-with the run's seed when the firmware starts a run.
+left (port and PWM compare registers) and takes back the ADC code the conversion reads, the
+count the quadrature encoder reaches and the bytes a sensor sends on Serial1. A plant without
+an ADC reading (the six-chamber rig's) steps on its own clock instead (`tick_us`), the
+harness reading the valve pins each step. The plant is the Python model of the in-process
+simulation (a `PinPlant`); it starts from rest with the run's seed when the firmware starts
+a run.
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ BUILD_HINT = "build it with: make -C firmware (needs apt-get install -y gcc-avr 
 class Pins(NamedTuple):
     """The firmware's outputs at the start of a control period, as the harness reads them."""
 
-    adc_channel: int  # the channel the starting conversion reads
+    adc_channel: int  # the channel the starting conversion reads (255: a tick, none)
     porta: int  # port registers: direction and valve pins
     portc: int
     porth: int
@@ -37,15 +39,25 @@ class Pins(NamedTuple):
     step_cycles: int  # CPU cycles the previous control step took
 
 
+class Inputs(NamedTuple):
+    """What the plant puts on the firmware's inputs for the period that starts."""
+
+    adc_code: int = 0  # what the starting conversion reads
+    encoder_count: int = 0  # where the quadrature encoder on D2/D3 goes
+    serial1: bytes = b""  # what a sensor sends on Serial1 now
+
+
 class PinPlant(Protocol):
     """A simulated plant behind the firmware's pins."""
+
+    tick_us: int | None  # the plant's own step [µs]; None: a step per ADC conversion
 
     def start(self, seed: int) -> None:
         """A run starts: the plant at rest, its noise drawn from `seed`."""
 
-    def period(self, pins: Pins) -> tuple[int, int]:
+    def period(self, pins: Pins) -> Inputs:
         """One control period: the outputs `pins` held since the last call act on the plant
-        (none before the first); returns (ADC code, encoder count) at the period's start."""
+        (none before the first); returns its inputs at the period's start."""
 
 
 class FirmwareRig:
@@ -66,6 +78,8 @@ class FirmwareRig:
         self.plant = plant
         self.step_cycles: list[int] = []  # per control period of the last run
         args = [str(harness), str(elf), "--plant"] + (["--realtime"] if realtime else [])
+        if plant.tick_us is not None:
+            args += ["--tick-us", str(plant.tick_us)]
         self._proc = subprocess.Popen(args, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                       text=True, bufsize=1)  # fmt: skip
         self.path = self._read_path()
@@ -90,9 +104,10 @@ class FirmwareRig:
             elif word == "sample":
                 pins = Pins(*map(int, numbers))
                 self.step_cycles.append(pins.step_cycles)
-                code, count = self.plant.period(pins)
+                inputs = self.plant.period(pins)
+                reply = f"{inputs.adc_code} {inputs.encoder_count} {inputs.serial1.hex()}\n"
                 try:
-                    self._proc.stdin.write(f"{code} {count}\n")
+                    self._proc.stdin.write(reply)
                     self._proc.stdin.flush()
                 except (BrokenPipeError, ValueError):
                     return  # the harness is gone

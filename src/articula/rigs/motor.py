@@ -20,7 +20,7 @@ from articula.errors import DeviceError
 from articula.plants.motor_rig import I_PRIMARY, OMEGA, THETA
 from articula.plants.motor_sensors import CurrentSensorParams, adc_code, encoder_count
 from articula.rigs.emulator import PlayedRun
-from articula.rigs.firmware import Pins
+from articula.rigs.firmware import Inputs, Pins
 from articula.rigs.programs import Program, Shape
 from articula.rigs.protocol import PROTOCOL_VERSION, Channel, Info, Kind, RigKind
 
@@ -107,6 +107,8 @@ class MotorPins:
     is that of the shaft angle. `trace` keeps the true (i, ω) [A, rad/s] per period.
     """
 
+    tick_us = None  # a control period per ADC conversion
+
     def __init__(
         self,
         Ad: np.ndarray,
@@ -131,8 +133,8 @@ class MotorPins:
         self._n = 0
         self.trace = []
 
-    def period(self, pins: Pins) -> tuple[int, int]:
-        """The outputs held over the last period act; (ADC code, encoder count) now."""
+    def period(self, pins: Pins) -> Inputs:
+        """The outputs held over the last period act; the ADC code and encoder count now."""
         if self._n > 0:
             volts = [self._voltage(duty, pins.porta, bit) for duty, bit in
                      zip((pins.ocr3a, pins.ocr4a), DIRECTION_BITS, strict=True)]  # fmt: skip
@@ -145,7 +147,7 @@ class MotorPins:
                         s.noise_sigma, s.adc_bits, s.adc_vref)  # fmt: skip
         self._n += 1
         self.trace.append((float(i), float(omega)))
-        return int(code), int(encoder_count(theta, self.counts_per_rev))
+        return Inputs(int(code), int(encoder_count(theta, self.counts_per_rev)))
 
     def _voltage(self, duty: int, porta: int, bit: int) -> float:
         """The H-bridge's mean voltage [V] for a duty count and its direction pins."""

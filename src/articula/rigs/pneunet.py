@@ -18,7 +18,7 @@ import numpy as np
 from articula.control.pid import PID, GainSchedule
 from articula.errors import ConfigError, DeviceError
 from articula.plants.pneunet import PneuNetBatch, PneuNetParams
-from articula.rigs.firmware import Pins
+from articula.rigs.firmware import Inputs, Pins
 from articula.rigs.link import Link
 from articula.rigs.programs import Program, Shape
 from articula.rigs.protocol import (
@@ -148,6 +148,8 @@ class PneuNetPins:
     flex sensor is read as the 10-bit ADC's code, its noise drawn from the run's seed as
     PneuNetDevice draws it."""
 
+    tick_us = None  # a PWM period per ADC conversion
+
     def __init__(self, params: PneuNetParams | None = None) -> None:
         self.params = params or PneuNetParams()
         built = PneuNetParams()
@@ -165,10 +167,10 @@ class PneuNetPins:
         self._plant = PneuNetBatch(self.params, 1, None)
         self._n = 0
 
-    def period(self, pins: Pins) -> tuple[int, int]:
-        """The last period's duty acts; (the flex sensor's ADC code, 0) now."""
+    def period(self, pins: Pins) -> Inputs:
+        """The last period's duty acts; the flex sensor's ADC code now."""
         if self._n > 0:
             pump = pins.porth >> PUMP_BIT & 1
             self._plant.advance(np.array([pump * min(pins.ocr1a, VALVE_TICKS) / VALVE_TICKS]))
         self._n += 1
-        return int(self._plant.read_code(self._rng.standard_normal(1))[0]), 0
+        return Inputs(int(self._plant.read_code(self._rng.standard_normal(1))[0]))
