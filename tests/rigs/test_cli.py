@@ -122,6 +122,8 @@ def test_rig_info_of_an_emulated_pneunet(emulated_pneunet, cli):
         (["emulate", "wobble"], "no emulator for 'wobble'"),
         (["emulate", "pneunet", "--plant", "x.toml"], "only the motor rig"),
         (["emulate", "pneunet", "--faults", "drop=3"], "probability"),
+        (["emulate", "motor", "--firmware", "/no/motor.elf"], "make -C firmware"),
+        (["emulate", "pneunet", "--firmware", "x.elf", "--faults", "drop=0.1"], "not on firmware"),
     ],
 )
 def test_bad_ports_and_options_are_one_line_and_exit_2(cli, args, words):
