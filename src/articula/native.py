@@ -16,7 +16,11 @@ from contextlib import contextmanager
 @contextmanager
 def captured_output() -> Iterator[list[str]]:
     """Send what is written to fds 1 and 2 inside the block to a buffer; the yielded list gets
-    its lines (stripped, non-empty) when the block ends."""
+    its lines (stripped, non-empty) when the block ends.
+
+    Yields:
+        The list that receives the captured lines once the block has ended.
+    """
     lines: list[str] = []
     sys.stdout.flush()
     sys.stderr.flush()

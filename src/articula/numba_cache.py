@@ -23,7 +23,14 @@ STAMP = "numba-sources.sha256"
 
 
 def sources_digest(root: Path) -> str:
-    """SHA-256 over every module under `root` that uses numba (path and bytes)."""
+    """SHA-256 over every module under `root` that uses numba (path and bytes).
+
+    Args:
+        root: the package folder to scan.
+
+    Returns:
+        The hexadecimal digest.
+    """
     digest = hashlib.sha256()
     for path in sorted(root.rglob("*.py")):
         data = path.read_bytes()
@@ -34,7 +41,14 @@ def sources_digest(root: Path) -> str:
 
 def refresh_cache(root: Path = PACKAGE) -> bool:
     """Delete every cached compilation under `root` if its numba sources changed since the
-    last call; returns True if it did. A read-only install is left as it is."""
+    last call; returns True if it did. A read-only install is left as it is.
+
+    Args:
+        root: the package folder whose `__pycache__` folders hold numba's cache.
+
+    Returns:
+        Whether the cache was cleared (False if it was current or not writable).
+    """
     digest = sources_digest(root)
     stamp = root / "__pycache__" / STAMP
     try:
@@ -59,6 +73,13 @@ def _refresh_once() -> None:
 
 
 def jit(**options: Any) -> Callable[[Callable[..., Any]], Any]:
-    """numba.njit with an on-disk cache that never outlives its sources (and `options`)."""
+    """numba.njit with an on-disk cache that never outlives its sources (and `options`).
+
+    Args:
+        **options: further options for numba.njit (e.g. `fastmath`, `parallel`).
+
+    Returns:
+        The decorator that compiles a function.
+    """
     _refresh_once()
     return numba.njit(cache=True, **options)

@@ -44,14 +44,31 @@ class StrictModel(BaseModel):
 
 def field_error(name: str, problem: str) -> ConfigError:
     """A ConfigError for a check across fields, raised inside a validator, that names `name`
-    (validation prefixes the path of the table it sits in)."""
+    (validation prefixes the path of the table it sits in).
+
+    Args:
+        name: the field the problem is reported on, relative to its table.
+        problem: what is wrong and how to fix it.
+
+    Returns:
+        The error, with its location set to `name`.
+    """
     error = ConfigError(name, problem)
     error.loc = (name,)
     return error
 
 
 def parse_model(model: type[M], data: Mapping[str, Any], where: str = "") -> M:
-    """Validate `data` into `model`, raising ConfigError naming the first bad field."""
+    """Validate `data` into `model`, raising ConfigError naming the first bad field.
+
+    Args:
+        model: the pydantic model class to build.
+        data: the raw table, e.g. as read from a TOML file.
+        where: the source of the data (a file name), prefixed to the field in errors.
+
+    Returns:
+        The validated model.
+    """
     try:
         return model.model_validate(dict(data))
     except ValidationError as exc:
@@ -63,6 +80,14 @@ def config_error_from(exc: ValidationError, where: str = "", owner: str = "") ->
 
     `where` (a file name) prefixes the field's path as "where: a.b"; `owner` (a class name) as
     "Owner.a.b".
+
+    Args:
+        exc: the pydantic failure.
+        where: the source of the data (a file name), or "".
+        owner: the class the fields belong to, or "".
+
+    Returns:
+        The error, naming the path of the first bad field.
     """
     first = exc.errors()[0]
     # Keys and list indices only: pydantic adds the name of a union's member it tried
@@ -89,7 +114,14 @@ def config_error_from(exc: ValidationError, where: str = "", owner: str = "") ->
 @contextmanager
 def fields_renamed(rename: Callable[[str | None], str | None]) -> Iterator[None]:
     """Re-raise a ConfigError or InfeasibleError raised inside with its field renamed by
-    `rename` (which returns None to leave an error as it is)."""
+    `rename` (which returns None to leave an error as it is).
+
+    Args:
+        rename: maps an error's field to the name to report, or to None to keep the error.
+
+    Yields:
+        Nothing; errors raised in the block are renamed.
+    """
     try:
         yield
     except ConfigError as exc:
@@ -106,12 +138,26 @@ def fields_renamed(rename: Callable[[str | None], str | None]) -> Iterator[None]
 
 def fields_as(paths: Mapping[str, str]) -> AbstractContextManager[None]:
     """Rename error fields from the argument name the library used to the config path the
-    user wrote (e.g. "q0" -> "robot.q0"); other errors pass unchanged."""
+    user wrote (e.g. "q0" -> "robot.q0"); other errors pass unchanged.
+
+    Args:
+        paths: config path by argument name.
+
+    Returns:
+        A context manager that renames the errors raised in its block.
+    """
     return fields_renamed(lambda field: paths.get(field) if field is not None else None)
 
 
 def load_toml(path: Path) -> dict[str, Any]:
-    """Read a TOML file into a dict, with errors that name the file."""
+    """Read a TOML file into a dict, with errors that name the file.
+
+    Args:
+        path: the TOML file (UTF-8).
+
+    Returns:
+        The file's tables and values.
+    """
     if not path.is_file():
         raise ConfigError(str(path), "file not found; pass the path of an existing TOML file")
     try:

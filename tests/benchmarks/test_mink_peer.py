@@ -1,4 +1,4 @@
-"""bench/mink_peer.py: mink's MuJoCo model is articula's arm and obstacles, and
+"""bench/mink_model.py, mink_peer.py: mink's MuJoCo model is articula's arm and obstacles, and
 benchmarks/peers.py runs (skipped without the `peers` extra)."""
 
 from __future__ import annotations
@@ -24,6 +24,7 @@ pytest.importorskip("mink", reason=INSTALL)
 
 BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
 peer = importlib.import_module("articula.bench.mink_peer")
+mink_model = importlib.import_module("articula.bench.mink_model")
 
 D_MIN, DETECTION, DT = 0.002, 0.15, 0.01
 CIRCLE = Circle.create([0.0, 0.6, 0.5], [1, 0, 0], [0, 0, 1], 0.2, 50.0)
@@ -47,9 +48,11 @@ def test_link_frames_and_end_effector_agree_with_articula(scene_q0):
         np.testing.assert_array_equal(arm.reset(q), q)
         poses = scene.robot.link_poses(q)
         for link in scene.robot.links:
-            mine = arm.site_pose(peer.link_site(link.name))
+            mine = arm.site_pose(mink_model.link_site(link.name))
             np.testing.assert_allclose(mine, poses[link.name], rtol=0, atol=1e-9)
-        np.testing.assert_allclose(arm.site_pose(peer.EE_SITE), scene.robot.ee_pose(q), atol=1e-9)
+        np.testing.assert_allclose(
+            arm.site_pose(mink_model.EE_SITE), scene.robot.ee_pose(q), atol=1e-9
+        )
         np.testing.assert_allclose(arm.ee_position(), scene.robot.ee_position(q), atol=1e-9)
 
 
@@ -63,13 +66,13 @@ def test_every_geom_is_articulas_hull_and_mujoco_collides_with_all_its_vertices(
             for k, (shape, T) in enumerate(zip(link.shapes, link.placements, strict=True)):
                 W = poses[link.name] @ T
                 ours = shape.vertices @ W[:3, :3].T + W[:3, 3]
-                name = peer.link_geom(link.name, k)
+                name = mink_model.link_geom(link.name, k)
                 _same_points(ours, arm.geom_vertices(name))
                 _same_points(ours, arm.hull_vertices(name))  # no hull vertex lost or added
     for obstacle in scene.obstacles:
         W = obstacle.pose_at(0.0)
         for k, part in enumerate(obstacle.parts):
-            name = peer.obstacle_geom(obstacle.name, k)
+            name = mink_model.obstacle_geom(obstacle.name, k)
             _same_points(part.vertices @ W[:3, :3].T + W[:3, 3], arm.hull_vertices(name))
 
 
@@ -100,7 +103,8 @@ def test_mujoco_distances_are_articulas_and_every_moving_link_obstacle_pair_is_k
             for oi, obstacle in enumerate(scene.obstacles):
                 if D[li, oi] <= 0:
                     continue  # penetration depths: EPA against MuJoCo's own, not compared
-                d = arm.distance(peer.link_geom(link.name, 0), peer.obstacle_geom(obstacle.name, 0),
+                d = arm.distance(mink_model.link_geom(link.name, 0),
+                                 mink_model.obstacle_geom(obstacle.name, 0),
                                  within=10.0)  # fmt: skip
                 assert d == pytest.approx(D[li, oi], abs=1e-5)  # MuJoCo's CCD tolerance 1e-6
 
@@ -115,7 +119,7 @@ def test_a_moved_obstacle_is_where_it_was_put(scene_q0):
     pose[:3, 3] += [0.5, 0.2, 0.1]
     arm.step(scene.robot.ee_position(q), {"rock": pose})
     _same_points(rock.parts[0].vertices @ pose[:3, :3].T + pose[:3, 3],
-                 arm.hull_vertices(peer.obstacle_geom("rock", 0)))  # fmt: skip
+                 arm.hull_vertices(mink_model.obstacle_geom("rock", 0)))  # fmt: skip
 
 
 def test_mink_keeps_d_min_past_the_bracket_with_a_damper_gain(scene_q0):

@@ -66,7 +66,14 @@ PLANNER = {"lambda_weight": 5e-5, "beta": 1.0, "d_min": D_MIN, "dt": DT, "c1": 0
 @dataclass(frozen=True)
 class Problem:
     """A generated problem: its plan config (a scene file's tables, mesh obstacles by file
-    name), the meshes to write beside it, and what kind of path it tracks."""
+    name), the meshes to write beside it, and what kind of path it tracks.
+
+    Attributes:
+        config: the plan config: experiment, robot (q0 the drawn start), obstacles,
+            trajectory and planner tables; a mesh obstacle names its file.
+        meshes: the rock obstacles' meshes by file name ("rock0.stl"), to write beside it.
+        path_kind: the path's kind: "circle" or "line" (out and back).
+    """
 
     config: dict[str, Any]
     meshes: dict[str, trimesh.Trimesh]
@@ -77,7 +84,16 @@ def generate(robot_table: dict[str, Any], seed: int, index: int) -> Problem:
     """Problem `index` of the suite of `seed` for the robot of a [robot] table (absolute paths).
 
     Raises InfeasibleError when no start, path or obstacle placement is found in ATTEMPTS
-    draws (a robot whose limits leave no reachable path, say)."""
+    draws (a robot whose limits leave no reachable path, say).
+
+    Args:
+        robot_table: a [robot] table with absolute paths; its q0, if any, is replaced.
+        seed: the suite's seed.
+        index: the problem's index; it draws from default_rng([seed, index]).
+
+    Returns:
+        The problem.
+    """
     rng = np.random.default_rng([seed, index])
     robot, checked = _robot(json.dumps({k: v for k, v in robot_table.items() if k != "q0"},
                                        sort_keys=True))  # fmt: skip

@@ -48,7 +48,11 @@ PEERS_INSTALL = "pip install -e '.[peers]'"
 
 
 def peers_missing() -> str | None:
-    """Why mink cannot run here (None when it can)."""
+    """Why mink cannot run here (None when it can).
+
+    Returns:
+        The missing module and how to install it, or None.
+    """
     try:
         import mink  # noqa: F401
         import mujoco  # noqa: F401
@@ -78,7 +82,13 @@ def run_suite(
         out: the suite folder; problems it finished before (same robot, seed and methods)
             are not run again.
         methods: articula methods and peers (PEER_METHODS) to run on every problem.
-        workers, dask: where the problems run (as for sweeps).
+        workers: most worker processes (as for sweeps).
+        dask: None, "local" or "tcp://HOST:PORT" of a Dask scheduler (as for sweeps).
+        force: write into an `out` holding files articula did not write.
+        progress: called with (problems done, problems), or None.
+
+    Returns:
+        The summary (summarize), as written to summary.json.
     """
     check_backend(dask)
     key = _suite_key(robot, seed, methods)
@@ -117,7 +127,16 @@ def _finished(task: Mapping[str, Any]) -> list[dict[str, Any]] | None:
 
 
 def solve_problem(task: Mapping[str, Any]) -> tuple[int, list[dict[str, Any]]]:
-    """Generate problem task["index"], write its folder, run every method; (index, rows)."""
+    """Generate problem task["index"], write its folder, run every method; (index, rows).
+
+    Args:
+        task: the problem's robot table, seed, index, methods, key (the suite's hash) and
+            folder.
+
+    Returns:
+        The index and one row per method: problem, method, path, obstacles, success,
+        failure, message, metrics (none after an error) and step_us (step times [µs]).
+    """
     folder = Path(task["folder"])
     problem = generate(task["robot"], task["seed"], task["index"])
     records.make_folder(folder)
@@ -209,7 +228,20 @@ def summarize(
 ) -> dict[str, Any]:
     """Per method: success rate, failures by class, median and p99 step time over all its
     periods, median RMS error and the smallest clearance; and each articula method's success
-    rate less the better mink's."""
+    rate less the better mink's.
+
+    Args:
+        rows: the rows of every problem and method (solve_problem), with their step_us.
+        methods: the methods to summarize.
+        robot: the suite's [robot] table, recorded.
+        seed: the suite's seed, recorded.
+        problems: the number of problems, recorded.
+
+    Returns:
+        The JSON-ready summary: robot, seed, problems, success_rms_m [m], settle_s [s], the
+        statistics of each method under "methods" and, when a peer ran,
+        best_mink_success_rate.
+    """
     out: dict[str, Any] = {"robot": dict(robot), "seed": seed, "problems": problems,
                            "success_rms_m": SUCCESS_RMS, "settle_s": SETTLE,
                            "methods": {}}  # fmt: skip

@@ -14,10 +14,12 @@ import sys
 import warnings
 from typing import NoReturn
 
+import typer
 from typer.exceptions import Abort, Exit, TyperException
 
 from articula.cli import arm, bench, book, rigs, runs, viewer  # noqa: F401  (each module adds its commands to app)
 from articula.cli.app import app
+from articula.cli.words import speak_in_words
 from articula.errors import ArticulaError, CollisionError, DeviceError, ResourceError
 
 BAD_INPUT, ENVIRONMENT, BUG, COLLIDES, INTERRUPTED = 2, 1, 3, 4, 130
@@ -32,7 +34,7 @@ def main(argv: list[str] | None = None) -> None:
     with warnings.catch_warnings(record=not debug) as caught:
         try:
             # Typer turns a Ctrl-C inside a command into Exit(130), which this mode returns.
-            if app(args=argv, standalone_mode=False) == INTERRUPTED:
+            if _command()(args=argv, standalone_mode=False) == INTERRUPTED:
                 raise KeyboardInterrupt
         except Exit as exc:
             sys.exit(exc.exit_code)
@@ -46,6 +48,13 @@ def main(argv: list[str] | None = None) -> None:
     if caught:
         first = f"{_one_line(str(caught[0].message))} ({caught[0].category.__name__})"
         sys.stderr.write(f"warning: {len(caught)} warning(s), the first: {first}\n")
+
+
+def _command() -> typer.core.TyperGroup:
+    """The app as a click command whose help names option types in words."""
+    command = typer.main.get_command(app)
+    speak_in_words(command, typer.Context(command))
+    return command
 
 
 def _status_and_message(exc: Exception) -> tuple[int, str]:

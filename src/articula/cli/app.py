@@ -14,8 +14,21 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-HELP = "`articula` command line: parses, calls the library, prints. Errors are one line, exit 2."
-app = typer.Typer(add_completion=False, no_args_is_help=True, help=HELP)
+HELP = """Control and decision-making for articulated robots and their soft end-effectors.
+
+articula tracks task-space paths with redundant arms (any URDF) around obstacles, controls soft
+bending and six-chamber actuators and DC-motor current, reproduces the book's experiments and
+drives the bench rigs over serial. The three most common commands:
+
+\b
+  articula reproduce all --out report            # the book's figures and tables, quick mode
+  articula plan SCENE.toml --out runs/circle      # an arm tracks a path around obstacles
+  articula run CONFIG.toml --out runs/fuzzy       # one experiment of chapters 2-4
+
+Errors are one line on stderr with an exit status: 2 bad input, 1 the machine, 3 a bug.
+Documentation: docs/ (mkdocs serve), examples: examples/.
+"""
+app = typer.Typer(add_completion=False, no_args_is_help=True, help=HELP, rich_markup_mode=None)
 motor_app = typer.Typer(no_args_is_help=True, help="Chapter 4: DC motor model and analysis.")
 app.add_typer(motor_app, name="motor")
 scene_app = typer.Typer(no_args_is_help=True, help="Chapter 1: robots, obstacles and clearances.")
@@ -24,7 +37,7 @@ err = Console(stderr=True)
 out = Console()
 
 JsonFlag = Annotated[bool, typer.Option("--json", help="Print one JSON object and nothing else.")]
-OutDir = Annotated[Path, typer.Option("--out", help="Output folder.")]
+OutDir = Annotated[Path, typer.Option("--out", metavar="FOLDER", help="Output folder.")]
 CORES = os.cpu_count() or 1  # default number of local worker processes
 MAX_WORKERS = 1024  # more would only queue
 Workers = Annotated[
@@ -40,6 +53,27 @@ Force = Annotated[
 Dask = Annotated[
     str | None, typer.Option(help="'local' for a loopback LocalCluster, or tcp://HOST:PORT.")
 ]
+
+
+def _print_version(wanted: bool) -> None:
+    """Print articula's version and stop (the eager --version option)."""
+    if wanted:
+        from articula import __version__
+
+        out.print(f"articula {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: Annotated[
+        bool,
+        typer.Option(
+            "--version", callback=_print_version, is_eager=True, help="Print the version."
+        ),
+    ] = False,
+) -> None:
+    """The options of `articula` itself."""
 
 
 def emit_json(obj: Any) -> None:

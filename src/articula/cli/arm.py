@@ -36,6 +36,9 @@ def plan(
     """Track the scene's reference path with its planner; writes a run folder (trace + record).
 
     A motion with a colliding step still writes its run folder, then exits with status 4.
+
+    \b
+    Example: articula plan src/articula/book/ch1/configs/circle_two_obstacles.toml --out runs/circle
     """
     from articula.book.ch1.experiment import load_plan
     from articula.runs.runner import run_to_folder
@@ -85,7 +88,11 @@ def scene_check(
     as_json: JsonFlag = False,
 ) -> None:
     """End-effector position, link-obstacle clearances and self clearance of a scene at q0, --q
-    or each row of --q-file."""
+    or each row of --q-file.
+
+    \b
+    Example: articula scene check SCENE.toml --q "0,0.5,0,-1,0,0.6,0" --json
+    """
     from articula.scene.check import check_scene
 
     result = check_scene(scene_file, q, metric, q_file)

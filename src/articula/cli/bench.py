@@ -49,7 +49,11 @@ def suite(
     as_json: JsonFlag = False,
 ) -> None:
     """Run every method on generated tracking problems; writes results.parquet, summary.json
-    and each problem as problems/NNN/scene.toml (runnable by `articula plan`)."""
+    and each problem as problems/NNN/scene.toml (runnable by `articula plan`).
+
+    \b
+    Example: articula bench suite --robot iiwa14 --problems 100 --out runs/suite --json
+    """
     from articula.bench.suite import ARTICULA_METHODS, PEER_METHODS, peers_missing, run_suite
     from articula.errors import ConfigError
     from articula.runs.folders import check_out

@@ -32,7 +32,11 @@ def reproduce(
     force: Force = False,
     as_json: JsonFlag = False,
 ) -> None:
-    """Reproduce the book's figures and tables into OUT/report.md and PNG figures."""
+    """Reproduce the book's figures and tables into OUT/report.md and PNG figures.
+
+    \b
+    Example: articula reproduce all --out report (or ch1 ... ch4; --full for the full size)
+    """
     from articula.book.reproduce import check_chapter
     from articula.book.reproduce import reproduce as run_reproduce
     from articula.runs.backends import check_backend
@@ -63,7 +67,11 @@ def motor_analyze(
     current: Annotated[float, typer.Option(help="Current for ω_c [A].")] = 1.0,
     as_json: JsonFlag = False,
 ) -> None:
-    """State space (4.6), G(s) (4.7), steady state (4.8) and critical speed ω_c of a motor."""
+    """State space (4.6), G(s) (4.7), steady state (4.8) and critical speed ω_c of a motor.
+
+    \b
+    Example: articula motor analyze --preset table4.2 --voltage 9 --torque -0.1 --json
+    """
     from articula.book.ch4.motor_analysis import analyze, load_params
 
     result = analyze(load_params(preset, params), voltage, torque, current)

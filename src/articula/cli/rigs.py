@@ -58,6 +58,7 @@ def emulate(
 ) -> None:
     """Start a simulated rig behind a pseudo-terminal and print its device path.
 
+    \b
     Example: articula emulate motor --firmware firmware/build/motor.elf, then articula rig
     info <the path it prints>"""
     from articula.errors import ConfigError
@@ -135,6 +136,7 @@ def _firmware_rig(rig: str, elf: Path, plant: Path | None, realtime: bool):
 def info(port: Port, as_json: JsonFlag = False) -> None:
     """Show what is on the port: rig kind, protocol and firmware versions, channels.
 
+    \b
     Example: articula rig info /dev/ttyACM0"""
     from rich.markup import escape  # "[deg]" is a unit, not rich markup
 
@@ -176,6 +178,7 @@ def run_(
 ) -> None:
     """Run an experiment config on the rig; the run folder is written as samples arrive.
 
+    \b
     Example: articula rig run /dev/ttyACM0 my_pid.toml --out runs/rig (a pneunet.pid config)"""
     import importlib
 
@@ -218,6 +221,7 @@ def record(
 ) -> None:
     """Run the rig with what it holds (gains, reference) and record every channel.
 
+    \b
     Example: articula rig record /dev/ttyACM0 --duration 10 --out runs/record"""
     from articula.rigs.link import Link
     from articula.rigs.recorder import Recorder
@@ -266,6 +270,7 @@ def tune(
     """Tune the PneuNet rig's PID with chapter 2's tuners, one experiment on the rig per
     probe (counted live); writes tuning.json.
 
+    \b
     Example: articula rig tune /dev/ttyACM0 --method descent --levels 30,60 --out runs/tuning"""
     import json
 

@@ -30,7 +30,11 @@ def run(
     force: Force = False,
     as_json: JsonFlag = False,
 ) -> None:
-    """Run one experiment config and write config.toml, record.json and trace.parquet."""
+    """Run one experiment config and write config.toml, record.json and trace.parquet.
+
+    \b
+    Example: articula run src/articula/book/ch2/configs/fuzzy_book_auto.toml --out runs/fuzzy
+    """
     from articula.runs.registry import with_absolute_paths
     from articula.runs.runner import run_to_folder
     from articula.validation import load_toml
@@ -57,7 +61,11 @@ def sweep(
     force: Force = False,
     as_json: JsonFlag = False,
 ) -> None:
-    """Run every config of a sweep, skipping finished runs; writes results.parquet."""
+    """Run every config of a sweep, skipping finished runs; writes results.parquet.
+
+    \b
+    Example: articula sweep src/articula/book/ch4/configs/bandwidth_quick.toml --out runs/bw
+    """
     from articula.runs.backends import check_backend
     from articula.runs.folders import check_out
     from articula.runs.runner import RESULTS, run_sweep

@@ -23,6 +23,7 @@ def view(
 ) -> None:
     """Replay a planned run in the browser: arm, obstacles, paths, closest pair, plots.
 
+    \b
     Example: articula view runs/circle --port 8080, then open the URL it prints."""
     from articula.viewer.replay import serve
 
@@ -44,6 +45,7 @@ def live(
 ) -> None:
     """Run the scene's planner in real time in the browser; drag obstacles and the target.
 
+    \b
     Example: articula live src/articula/book/ch1/configs/circle_two_obstacles.toml --method qp"""
     from articula.errors import ConfigError
     from articula.runs.folders import check_out

@@ -15,10 +15,13 @@ from articula.validation import NonNegative, StrictModel
 class DampingPolicy(StrictModel):
     """On deactuating a side, pulse the opposite side to δ times its pressure (Eq. 3.4).
 
-    delta: damping actuation ratio δ (0 = no damping). start [s]: delay of the opposite fill
-    after the deactuation command (0 = simultaneous, as in Sect. 3.2.4). length [s]: time from
-    opening the fill valve to venting; the valve fills for the open time that reaches δ·P, holds
-    for the rest, and vents no earlier than filled (0 = vent as soon as filled, the brief pulse).
+    Attributes:
+        delta: damping actuation ratio δ, at most 0.95 (0 = no damping).
+        start: delay of the opposite fill after the deactuation command (0 = simultaneous,
+            as in Sect. 3.2.4) [s].
+        length: time from opening the fill valve to venting; the valve fills for the open
+            time that reaches δ·P, holds for the rest, and vents no earlier than filled
+            (0 = vent as soon as filled, the brief pulse) [s].
     """
 
     delta: Annotated[float, Field(ge=0, le=0.95, allow_inf_nan=False)] = 0.0
@@ -30,8 +33,17 @@ class DampingPolicy(StrictModel):
     ) -> list[tuple[float, int, int]]:
         """Valve events (time [s], chamber, mode) of the pulse for a deactuation at t_off [s].
 
-        `pressures` [Pa] are the deactuated chambers' gauge pressures; chamber i's pulse goes
-        to chamber i + 3 at δ·pressures[i], filled by the valve open time that reaches it.
+        Chamber i's pulse goes to chamber i + 3 at δ·pressures[i], filled by the valve open
+        time that reaches it.
+
+        Args:
+            p: parameters of the six-chamber actuator (supply and valve flow).
+            pressures: gauge pressures of the deactuated chambers, shape (6,) [Pa].
+            t_off: time of the deactuation command [s].
+
+        Returns:
+            The valve events as (time [s], chamber index, valve mode FILL/HOLD/VENT) tuples,
+            empty if δ = 0.
         """
         events: list[tuple[float, int, int]] = []
         if self.delta == 0:

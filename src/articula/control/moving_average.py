@@ -12,10 +12,15 @@ from articula.numba_cache import jit
 def moving_average_push(buffer: np.ndarray, n: int, samples: np.ndarray, means: np.ndarray) -> None:
     """Store sample number n of each column and write the mean of its last k samples.
 
-    `buffer` is (k, batch) and `samples`, `means` are (batch,). Eq. (4.17) prints a sum over
-    k + 1 samples; we average the last k samples so that the filter has unit DC gain
-    (docs/deviations.md). The buffer starts at zero, as in firmware: the samples before the
-    start count as 0 A, which they are for a motor at rest.
+    Eq. (4.17) prints a sum over k + 1 samples; we average the last k samples so that the
+    filter has unit DC gain (docs/deviations.md). The buffer starts at zero, as in firmware:
+    the samples before the start count as 0 A, which they are for a motor at rest.
+
+    Args:
+        buffer: ring buffer of the last k samples, shape (k, batch), updated in place.
+        n: index of this sample (0 for the first); its slot in the ring is n mod k.
+        samples: the new sample of each trial, shape (batch,).
+        means: output, written in place: the filtered value of each trial, shape (batch,).
     """
     k, batch = buffer.shape
     slot = n % k
@@ -30,7 +35,15 @@ def moving_average_push(buffer: np.ndarray, n: int, samples: np.ndarray, means: 
 
 
 def moving_average(signal: np.ndarray, order: int) -> np.ndarray:
-    """The loop's causal moving average along the last axis of a whole signal (zero history)."""
+    """The loop's causal moving average along the last axis of a whole signal (zero history).
+
+    Args:
+        signal: sampled signal, shape (..., n); filtered along the last axis.
+        order: filter order k, the number of samples averaged (1 = no filtering).
+
+    Returns:
+        The filtered signal, same shape as `signal`.
+    """
     if order < 1:
         raise ConfigError("filter_order", f"must be >= 1 (got {order}); 1 means no filtering")
     x = np.asarray(signal, dtype=float)

@@ -29,6 +29,11 @@ class GainSchedule:
     neighbouring points and constant beyond the outer ones, so continuous everywhere.
     Points and θ_r share one unit (degrees in chapter 2, as the book's gains are per degree).
     Gains and points are stored as read-only copies.
+
+    Attributes:
+        kind: how gains vary with θ_r: "constant", "piecewise" or "fuzzy".
+        gains: rows [K_p, K_i, K_d], one per representative point, shape (rows, 3).
+        points: representative points of θ_r, increasing, shape (rows,) (ignored if constant).
     """
 
     kind: ScheduleKind
@@ -73,7 +78,14 @@ class GainSchedule:
         return 0.5 * (self.points[1:] + self.points[:-1])
 
     def __call__(self, reference: np.ndarray | float) -> np.ndarray:
-        """Gains [K_p, K_i, K_d] per reference: shape reference.shape + (3,); (3,) if constant."""
+        """Gains [K_p, K_i, K_d] scheduled on the reference.
+
+        Args:
+            reference: reference θ_r, scalar or array, in the unit of the points.
+
+        Returns:
+            The gains, shape reference.shape + (3,); (3,) if constant.
+        """
         if self.kind == "constant":
             return self.gains[0]
         r = np.asarray(reference, dtype=float)
@@ -85,8 +97,13 @@ class GainSchedule:
 class PID:
     """u[n] = K(θ_r)ᵀ E[n] (Eqs. 2.3-2.4), vectorised over trials, with limits and anti-windup.
 
-    output_limits: actuator range (chapter 2: PWM counts 0-255). derivative_tau [s]: time
-    constant of an optional first-order filter on Δe/Δt (0: the raw difference of Eq. 2.2).
+    Args:
+        schedule: gains K(θ_r) of Eq. (2.4).
+        output_limits: actuator range (low, high) the output is clipped to (chapter 2: PWM
+            counts 0-255).
+        derivative_tau: time constant of an optional first-order filter on Δe/Δt (0: the raw
+            difference of Eq. 2.2) [s].
+        trials: number of trials controlled at once (the batch size).
     """
 
     def __init__(
@@ -109,7 +126,11 @@ class PID:
         self.reset(trials)
 
     def reset(self, trials: int) -> None:
-        """Forget the past: no previous sample, zero integral."""
+        """Forget the past: no previous sample, zero integral.
+
+        Args:
+            trials: number of trials controlled at once (the batch size).
+        """
         self.integral = np.zeros(trials)  # Σ e[i] Δt_i of Eq. (2.2)
         self.derivative = np.zeros(trials)  # (filtered) Δe_n/Δt_n of Eq. (2.2)
         self.last_error: np.ndarray | None = None
@@ -120,6 +141,14 @@ class PID:
 
         At the first sample there is no previous one, so Δt = 0: it adds nothing to the
         integral and the derivative is zero.
+
+        Args:
+            t: sample time, increasing from call to call [s].
+            reference: reference θ_r, scalar or shape (trials,).
+            measured: measured output θ[n], shape (trials,).
+
+        Returns:
+            The control output u[n], clipped to the output limits, shape (trials,).
         """
         error = reference - measured  # e[n] = θ_r − θ[n]
         if self.last_error is None:

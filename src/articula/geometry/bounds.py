@@ -9,7 +9,14 @@ import numpy as np
 
 @dataclass(frozen=True)
 class Capsule:
-    """Segment of `length` [m] along the z axis of `pose` (4×4, shape frame), `radius` [m]."""
+    """Segment of `length` [m] along the z axis of `pose` (4×4, shape frame), `radius` [m].
+
+    Attributes:
+        pose: pose of the capsule in the shape frame, shape (4, 4); the segment is centred on
+            its origin and runs along its z axis [m].
+        radius: distance from the segment that the capsule reaches [m].
+        length: length of the segment between the centres of the two caps [m].
+    """
 
     pose: np.ndarray
     radius: float
@@ -22,6 +29,12 @@ def bounding_capsule(vertices: np.ndarray) -> Capsule:
     The radius is the largest distance from the axis; each end of the segment is pulled in as
     far as the vertices allow (a vertex at axial position t and distance ρ stays inside while
     the end is within sqrt(r² − ρ²) of t).
+
+    Args:
+        vertices: points to contain, shape (n, 3) [m].
+
+    Returns:
+        The bounding capsule, in the frame of the vertices.
     """
     pts = np.asarray(vertices, dtype=float)
     mean = pts.mean(axis=0)

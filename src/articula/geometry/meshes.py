@@ -22,6 +22,14 @@ def load_mesh(path: Path, scale: float | tuple[float, float, float] = 1.0) -> tr
 
     Scenes and multi-body files are merged into one mesh. Not being watertight is accepted:
     distances use convex hulls, which need only the vertices.
+
+    Args:
+        path: the mesh file (.stl, .obj, .ply or .dae).
+        scale: factor from the file's units to metres, one for all axes or one per axis
+            (x, y, z), as in a URDF `<mesh scale>`.
+
+    Returns:
+        The scaled triangle mesh [m], duplicate vertices merged.
     """
     path = Path(path)
     if not path.is_file():
@@ -64,6 +72,16 @@ def convex_parts(
     The hull is conservative (every point of the mesh is inside it). The decomposition follows
     concavities more tightly, to within `threshold` (CoACD's concavity bound, relative); it
     refuses a mesh of more than `max_vertices` vertices, whose decomposition would run for long.
+
+    Args:
+        mesh: the triangle mesh to approximate [m].
+        name: what the mesh is (e.g. its file), for the error messages and the parts' names.
+        decompose: whether to split the mesh into convex parts with CoACD instead of one hull.
+        threshold: CoACD's concavity bound, relative to the mesh size, in (0, 1].
+        max_vertices: largest mesh, in vertices, that a decomposition accepts.
+
+    Returns:
+        The convex parts, in the mesh's frame: one hull, or one per decomposed piece.
     """
     if not decompose:
         return [convex_hull(mesh.vertices, name)]
@@ -94,7 +112,11 @@ def convex_parts(
 
 
 def cache_folder() -> Path:
-    """Where convex decompositions are kept: $ARTICULA_CACHE_DIR, else the user's cache."""
+    """Where convex decompositions are kept: $ARTICULA_CACHE_DIR, else the user's cache.
+
+    Returns:
+        The cache folder (it may not exist yet).
+    """
     if "ARTICULA_CACHE_DIR" in os.environ:
         return Path(os.environ["ARTICULA_CACHE_DIR"])
     base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"

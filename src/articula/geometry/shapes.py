@@ -21,6 +21,12 @@ class ConvexShape:
 
     `vertices` are exact for polytopes and a fine tessellation (on the surface) for round
     primitives; `bound` contains the solid itself, not only the tessellation.
+
+    Attributes:
+        kind: the solid's type: "convex", "box", "sphere", "cylinder" or "capsule".
+        geometry: the coal collision geometry used for the distance queries.
+        vertices: vertices in the shape frame, shape (n, 3) [m].
+        bound: bounding capsule for the broad phase, in the shape frame.
     """
 
     kind: str
@@ -30,7 +36,15 @@ class ConvexShape:
 
 
 def convex_hull(points: np.ndarray, name: str = "points") -> ConvexShape:
-    """Convex hull of an (n, 3) point set; GeometryError if it is empty, non-finite or flat."""
+    """Convex hull of an (n, 3) point set; GeometryError if it is empty, non-finite or flat.
+
+    Args:
+        points: the points to wrap, shape (n, 3) [m].
+        name: what the points are, for the error messages.
+
+    Returns:
+        The convex hull as a shape of kind "convex".
+    """
     pts = np.asarray(points, dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 3 or len(pts) == 0:
         raise GeometryError(f"{name}: need an (n, 3) array of vertices (got shape {pts.shape})")
@@ -49,7 +63,14 @@ def convex_hull(points: np.ndarray, name: str = "points") -> ConvexShape:
 
 
 def box(size: tuple[float, float, float]) -> ConvexShape:
-    """Box with edge lengths `size` [m], centred on its frame."""
+    """Box with edge lengths `size` [m], centred on its frame.
+
+    Args:
+        size: edge lengths along x, y and z [m].
+
+    Returns:
+        The box, with its 8 corners as vertices.
+    """
     x, y, z = _positive("box", size, 3)
     half = 0.5 * np.array([x, y, z])
     corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * half
@@ -57,14 +78,29 @@ def box(size: tuple[float, float, float]) -> ConvexShape:
 
 
 def sphere(radius: float) -> ConvexShape:
-    """Sphere of `radius` [m] centred on its frame."""
+    """Sphere of `radius` [m] centred on its frame.
+
+    Args:
+        radius: radius of the sphere [m].
+
+    Returns:
+        The sphere, with an icosphere tessellation as vertices.
+    """
     (r,) = _positive("sphere", (radius,), 1)
     vertices = np.asarray(trimesh.creation.icosphere(subdivisions=2, radius=r).vertices)
     return ConvexShape("sphere", coal.Sphere(r), vertices, Capsule(np.eye(4), r, 0.0))
 
 
 def cylinder(radius: float, length: float) -> ConvexShape:
-    """Cylinder of `radius` and `length` [m] along its z axis, centred on its frame."""
+    """Cylinder of `radius` and `length` [m] along its z axis, centred on its frame.
+
+    Args:
+        radius: radius of the cylinder [m].
+        length: length of the cylinder along z [m].
+
+    Returns:
+        The cylinder, with a tessellation as vertices.
+    """
     r, h = _positive("cylinder", (radius, length), 2)
     vertices = np.asarray(
         trimesh.creation.cylinder(radius=r, height=h, sections=_SECTIONS).vertices
@@ -73,7 +109,15 @@ def cylinder(radius: float, length: float) -> ConvexShape:
 
 
 def capsule(radius: float, length: float) -> ConvexShape:
-    """Capsule: a cylinder of `radius` and `length` [m] along z with hemispherical caps."""
+    """Capsule: a cylinder of `radius` and `length` [m] along z with hemispherical caps.
+
+    Args:
+        radius: radius of the cylinder and of the caps [m].
+        length: length of the cylinder along z, between the centres of the caps [m].
+
+    Returns:
+        The capsule, with a tessellation as vertices.
+    """
     r, h = _positive("capsule", (radius, length), 2)
     mesh = trimesh.creation.capsule(height=h, radius=r, count=[_SECTIONS, _SECTIONS])
     vertices = np.asarray(mesh.vertices)

@@ -28,7 +28,28 @@ SUMS = (
 
 @dataclass(frozen=True)
 class LoopSettings:
-    """Everything the compiled loop needs, as plain numbers: gains, sensors, PWM, sample time."""
+    """Everything the compiled loop needs, as plain numbers: gains, sensors, PWM, sample time.
+
+    Attributes:
+        dt: control period [s].
+        v_bias: constant feed-forward voltage of Eq. (4.13) [V].
+        kp: proportional gain of the current PI, Eq. (4.14) [V/A].
+        ki: integral gain of the current PI [V/(A·s)].
+        filter_order: length of the current's moving average, Eq. (4.17) [samples].
+        dual: the dual rig, whose secondary motor runs the speed PI of Eq. (4.12).
+        kp_speed: proportional gain of the speed PI [V·s/rad].
+        ki_speed: integral gain of the speed PI [V/rad].
+        v_max: supply voltage of the drivers, the largest |V| [V].
+        pwm_bits: PWM resolution [bits]; 0: ideal driver (saturation only).
+        sensor_ideal: read the true current (no noise, no ADC).
+        sensitivity: current sensor output per ampere [V/A].
+        zero_voltage: current sensor output at 0 A [V].
+        noise_sigma: standard deviation of the current sensor's output noise [V].
+        adc_bits: ADC resolution [bits].
+        adc_vref: ADC reference voltage [V].
+        encoder_cpr: encoder counts per revolution; 0: ideal speed measurement.
+        encoder_window: samples over which the encoder's count difference gives the speed.
+    """
 
     dt: float  # [s]
     v_bias: float  # [V] constant feed-forward of Eq. (4.13)
@@ -52,7 +73,13 @@ class LoopSettings:
 
 @dataclass(frozen=True)
 class MetricWindow:
-    """What the loop's running sums need: where steady state starts and what a rise is."""
+    """What the loop's running sums need: where steady state starts and what a rise is.
+
+    Attributes:
+        settle_index: first sample of the steady-state window.
+        rise_target: step target for the 10-90 % rise times [A]; NaN: no rise time.
+        frequency: frequency of the sinusoidal reference [rad/s]; 0: no sinusoid fit.
+    """
 
     settle_index: int  # first sample of the steady-state window
     rise_target: float  # [A] step target for 10-90 % rise times; NaN: no rise time
@@ -71,9 +98,23 @@ def simulate_loop(
 ) -> tuple[dict[str, np.ndarray] | None, dict[str, np.ndarray]]:
     """Run a batch of closed loops; `noise` is (batch, steps) standard normals.
 
-    Returns the channels as (batch, steps) arrays sampled at the start of each step (None
-    when `record` is False, which saves the memory of long Monte Carlo batches) and the
-    running sums of SUMS as (batch,) arrays.
+    Args:
+        Ad: ZOH state matrix of the rig (motor_rig.discretize), shape (n, n).
+        Bd: ZOH input matrix of the rig for [V₁, V₂], shape (n, 2).
+        settings: gains, sensors, PWM and control period of the loop.
+        window: steady-state start, rise target and sinusoid frequency of the running sums.
+        i_ref: current reference at each step, shape (steps,) [A].
+        omega_ref: speed reference of the dual rig's speed loop [rad/s].
+        noise: standard normal draws of the current sensor, shape (batch, steps).
+        record: keep the channels; False saves the memory of long Monte Carlo batches.
+
+    Returns:
+        channels: name in CHANNELS -> (batch, steps) array sampled at the start of each
+            step (i, i_meas, i_fb [A], omega, omega_meas [rad/s], v1 [V], duty1 [counts],
+            v2 [V]); None when `record` is False.
+        sums: name in SUMS -> (batch,) array; sums over the steady-state window (error,
+            error_sq, noise_sq, omega, i, i_sin, i_cos), saturated steps over the whole run,
+            and the 10 % / 90 % crossing times t10, t90, t10_fb, t90_fb [s] (NaN: none).
     """
     batch, steps = noise.shape
     # Time-major layout: the compiled loop walks the batch innermost, where it vectorises.

@@ -10,12 +10,29 @@ from articula.plants.motor_rig import I_PRIMARY, OMEGA, THETA
 
 
 def pi_discrete(kp: float, ki: float, dt: float) -> ct.TransferFunction:
-    """The loop's PI, u = kp·e + ki·Σe·dt with the sum including the present error."""
+    """The loop's PI, u = kp·e + ki·Σe·dt with the sum including the present error.
+
+    Args:
+        kp: proportional gain (e.g. [V/A]).
+        ki: integral gain (e.g. [V/(A·s)]).
+        dt: sample time [s].
+
+    Returns:
+        The discrete PI ((kp + ki dt) z − kp) / (z − 1).
+    """
     return ct.tf([kp + ki * dt, -kp], [1.0, -1.0], dt)
 
 
 def moving_average_tf(order: int, dt: float) -> ct.TransferFunction:
-    """Mean of the last `order` samples, Eq. (4.17) as a mean: Σ z^-j / k."""
+    """Mean of the last `order` samples, Eq. (4.17) as a mean: Σ z^-j / k.
+
+    Args:
+        order: number k of samples averaged.
+        dt: sample time [s].
+
+    Returns:
+        The discrete moving-average filter.
+    """
     num = np.ones(order) / order
     den = np.zeros(order)
     den[0] = 1.0
@@ -23,7 +40,17 @@ def moving_average_tf(order: int, dt: float) -> ct.TransferFunction:
 
 
 def closed_loop(Ad: np.ndarray, Bd: np.ndarray, s: LoopSettings) -> ct.StateSpace:
-    """Discrete closed loop from the current reference r [A] to the motor current i [A]."""
+    """Discrete closed loop from the current reference r [A] to the motor current i [A].
+
+    Args:
+        Ad: ZOH state matrix of the rig, shape (n, n), states [θ, ω, i₁(, i₂)].
+        Bd: ZOH input matrix of the rig, shape (n, 2), inputs [V₁, V₂].
+        s: the loop's gains, filter order and control period (sensor and PWM ignored).
+
+    Returns:
+        The closed loop r -> i with plant, moving average, current PI and, on the dual rig,
+            the speed PI, the shaft angle dropped.
+    """
     # The shaft angle drives nothing in the linear loop (ideal encoder): drop it, leaving its
     # pole at z = 1 out of the stability test and the DC gain.
     keep = np.arange(Ad.shape[0]) != THETA
@@ -47,7 +74,14 @@ def closed_loop(Ad: np.ndarray, Bd: np.ndarray, s: LoopSettings) -> ct.StateSpac
 
 
 def is_stable(sys: ct.StateSpace) -> bool:
-    """True when every closed-loop pole lies strictly inside the unit circle."""
+    """True when every closed-loop pole lies strictly inside the unit circle.
+
+    Args:
+        sys: a discrete-time system.
+
+    Returns:
+        Whether the system is asymptotically stable.
+    """
     return bool(np.all(np.abs(sys.poles()) < 1.0))
 
 
@@ -55,6 +89,14 @@ def bandwidth(sys: ct.StateSpace, dt: float, points: int = 400) -> float:
     """First frequency [rad/s] where |i/r| falls 3 dB below its DC gain; inf below Nyquist.
 
     The crossing is bracketed on a log grid, then refined by bisection to 1e-6 relative.
+
+    Args:
+        sys: the discrete closed loop r -> i (closed_loop).
+        dt: sample time [s], which sets the Nyquist frequency π/dt.
+        points: size of the log grid from 0.01 rad/s to Nyquist.
+
+    Returns:
+        The −3 dB bandwidth [rad/s]; inf when the gain stays above it below Nyquist.
     """
     level = 10 ** (-3 / 20)
     dc = abs(sys.dcgain())
@@ -76,7 +118,16 @@ def bandwidth(sys: ct.StateSpace, dt: float, points: int = 400) -> float:
 
 
 def first_crossing(freq: np.ndarray, ratio: np.ndarray, level: float) -> float:
-    """Frequency where `ratio` first drops below `level`, log-interpolated; inf if it never does."""
+    """Frequency where `ratio` first drops below `level`, log-interpolated; inf if it never does.
+
+    Args:
+        freq: frequencies, increasing, shape (k,) (any unit, e.g. [rad/s]).
+        ratio: magnitude ratio at each frequency, shape (k,).
+        level: threshold ratio (e.g. 10^(−3/20) for −3 dB).
+
+    Returns:
+        The first crossing frequency, in the unit of `freq`; freq[0] if already below there.
+    """
     below = np.nonzero(ratio < level)[0]
     if below.size == 0:
         return float("inf")

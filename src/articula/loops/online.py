@@ -25,13 +25,27 @@ from articula.scene.scene import Scene
 
 
 class LivePose:
-    """An obstacle pose a live loop sets each period; as a pose function it ignores time."""
+    """An obstacle pose a live loop sets each period; as a pose function it ignores time.
+
+    Args:
+        pose: the obstacle's starting pose, 4×4 homogeneous transform in the world [m].
+
+    Attributes:
+        pose: the last pose set, 4×4 homogeneous transform in the world [m].
+    """
 
     def __init__(self, pose: np.ndarray) -> None:
         self.pose = np.array(pose, dtype=float)
 
     def __call__(self, t: float) -> np.ndarray:
-        """The last pose set [4×4, world]."""
+        """The last pose set [4×4, world].
+
+        Args:
+            t: time [s], ignored.
+
+        Returns:
+            The obstacle's pose, 4×4 homogeneous transform in the world [m].
+        """
         return self.pose
 
 
@@ -42,6 +56,12 @@ class OnlineController:
         planner: any articula planner (BAORNN, baornn-improved, pinv, dls, qp).
         dt: the control period [s].
         live: obstacle name -> its LivePose, for the obstacles step() may move.
+
+    Attributes:
+        periods: control periods since reset; the time is periods · dt [s].
+        q: the last commanded joint positions, shape (n,) [rad]; None before reset.
+        held: the start's tool pose, whose orientation and axis fill in what a target lacks.
+        target: the last period's target, completed.
     """
 
     def __init__(
@@ -62,7 +82,17 @@ class OnlineController:
         cls, scene: Scene, spec: PlannerSpec, seed: int = 0, live_obstacles: bool = False
     ) -> OnlineController:
         """The controller of a [planner] table on `scene`; with `live_obstacles`, step() takes
-        each obstacle's pose (the scene's poses are the starting ones)."""
+        each obstacle's pose (the scene's poses are the starting ones).
+
+        Args:
+            scene: the robot and its obstacles.
+            spec: the [planner] table: method, its parameters and the control period dt.
+            seed: seed of the planner's random numbers (BAORNN's).
+            live_obstacles: let step() move every obstacle of the scene.
+
+        Returns:
+            A controller to reset() before its first step().
+        """
         live: dict[str, LivePose] = {}
         if live_obstacles:
             obstacles = []
@@ -74,9 +104,19 @@ class OnlineController:
         return cls(make_planner(spec, scene, seed), spec.dt, live)
 
     def reset(self, q: Sequence[float] | np.ndarray) -> np.ndarray:
-        """Start from q [rad] at rest, at t = 0; InfeasibleError naming `q0` for a start
-        outside the joint limits, in collision (with an obstacle or, for a checked link pair,
-        with itself), or within d_min of an obstacle."""
+        """Start from q [rad] at rest, at t = 0, once the start is checked.
+
+        Args:
+            q: the arm's measured joint positions, shape (n,) [rad].
+
+        Returns:
+            A copy of the checked start, shape (n,) [rad].
+
+        Raises:
+            InfeasibleError: naming `q0`, for a start outside the joint limits, in collision
+                (with an obstacle or, for a checked link pair, with itself), or within d_min
+                of an obstacle.
+        """
         scene, robot = self.planner.scene, self.planner.scene.robot
         start = robot.check_q(q, "q0").copy()
         if np.any(start < robot.lower) or np.any(start > robot.upper):
@@ -112,11 +152,16 @@ class OnlineController:
         target: Sequence[float] | np.ndarray | Target,
         obstacle_poses: Mapping[str, np.ndarray] | None = None,
     ) -> np.ndarray:
-        """One control period toward the target; obstacle_poses moves live obstacles (name ->
-        4×4 pose in the world) first. Returns the new configuration [rad].
+        """One control period toward the target; obstacle_poses moves live obstacles first.
 
-        The target is a position [m] (3 numbers), a pose (4×4, world) or a Target; an
-        orientation or axis the task needs and the target lacks is the start's, held.
+        Args:
+            target: a position (3,) [m], a pose (4×4, world) or a Target; an orientation or
+                axis the task needs and the target lacks is the start's, held.
+            obstacle_poses: live obstacle name -> its new pose (4×4, world) [m]; None: none
+                moves.
+
+        Returns:
+            The new joint positions to send to the arm, shape (n,) [rad].
         """
         if self.q is None or self.held is None:
             raise ConfigError("reset", "call reset(q) with the arm's configuration first")

@@ -22,6 +22,13 @@ class ClosedLoopTrace:
     """Times [s] (n,), reference [°] (n,); measured, true angle [°] and duty, (trials, n).
 
     The arrays are read-only.
+
+    Attributes:
+        t: start time of each PWM period, shape (n,) [s].
+        reference: reference angle, shape (n,) [°].
+        measured: angle the flex sensor reads, shape (trials, n) [°].
+        theta: true bending angle, shape (trials, n) [°].
+        duty: valve duty cycle applied, shape (trials, n), in [0, 1].
     """
 
     t: np.ndarray
@@ -40,12 +47,21 @@ def run_closed_loop(
 ) -> ClosedLoopTrace:
     """Run the controller against one actuator per seed; reference [°] at each PWM period.
 
-    vary: scale each trial's actuator by its own draw of PneuNetParams.trial_factors; False
-    keeps the nominal actuator for every trial (only the sensor noise differs).
-
     Trial i splits numpy.random.SeedSequence(seeds[i]) into two streams: the first draws its
     sensor noise, the second its actuator variation. So a trial gives the same numbers alone or
     in a batch, and trial i is the same actuator whatever the run's length (or frequency).
+
+    Args:
+        params: the actuator's constants.
+        controller: the PID, reference and measurement in degrees, output the PWM count
+            (its upper output limit is full duty); reset to `len(seeds)` trials first.
+        reference: reference angle at each PWM period, shape (n,) [°].
+        seeds: one seed per trial.
+        vary: scale each trial's actuator by its own draw of PneuNetParams.trial_factors;
+            False keeps the nominal actuator for every trial (only the sensor noise differs).
+
+    Returns:
+        The trace of every trial, read-only.
     """
     steps = reference.size
     trials = len(seeds)
@@ -78,6 +94,14 @@ class SimulatedRig:
 
     Each call is a new experiment with fresh sensor noise (seed, seed + 1, ...) on the same,
     nominal actuator, as in one tuning session on a rig.
+
+    Args:
+        params: the actuator's constants.
+        reference: reference angle at each PWM period, shape (n,) [°].
+        seed: seed of the first experiment's sensor noise.
+
+    Attributes:
+        calls: experiments run so far.
     """
 
     def __init__(self, params: PneuNetParams, reference: np.ndarray, seed: int) -> None:
@@ -87,7 +111,14 @@ class SimulatedRig:
         self.calls = 0
 
     def __call__(self, gains: np.ndarray) -> Response:
-        """One experiment from rest with constant gains [K_p, K_i, K_d]."""
+        """One experiment from rest with constant gains [K_p, K_i, K_d].
+
+        Args:
+            gains: [K_p, K_i, K_d], shape (3,), from the error [°] to the PWM count.
+
+        Returns:
+            The reference [°] and measured angle [°] over time [s].
+        """
         schedule = GainSchedule("constant", np.asarray(gains, dtype=float)[None, :])
         pid = PID(schedule, (0.0, 255.0))
         trace = run_closed_loop(

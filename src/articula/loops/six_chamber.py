@@ -26,7 +26,15 @@ from articula.plants.six_chamber_sim import (
 
 @dataclass(frozen=True)
 class Deactuation:
-    """A simulated run: the plant samples, the sensor's samples and the bending direction."""
+    """A simulated run: the plant samples, the sensor's samples and the bending direction.
+
+    Attributes:
+        sim: the plant's recorded samples.
+        sensor_t: the orientation sensor's sample times, shape (n,) [s].
+        sensor_bend: bending vector from the sensor's roll/pitch/yaw, shape (n, 2) [rad].
+        direction: unit vector toward which the side bends the body, shape (2,).
+        t_off: deactuation instant, when the side is vented [s].
+    """
 
     sim: Simulation
     sensor_t: np.ndarray
@@ -43,6 +51,16 @@ def valve_program(
     A chamber at the supply pressure stays open to the pump; one below it is regulated to its
     pressure (REGULATE), so at the vent command every chamber of the side is at the pressure
     it was commanded, the denominator of Eq. (3.4).
+
+    Args:
+        p: actuator constants.
+        side_deg: side that is pressurised, chamber i sitting at 60°·i [deg].
+        gauge: gauge pressure of the equivalent single chamber at `side_deg` [Pa].
+        hold: time at which the side is vented [s].
+        damping: the policy whose pulse on the opposite chambers damps the deactuation.
+
+    Returns:
+        The valve events of the whole run.
     """
     pressures = side_pressures(side_deg, gauge)
     events: list = []
@@ -63,7 +81,22 @@ def deactuate(
     rng: np.random.Generator,
 ) -> Deactuation:  # fmt: skip
     """Run `program` for hold + after [s] at step dt [s], keeping every record_every-th
-    sample, and read the sensor (its noise from `rng`)."""
+    sample, and read the sensor (its noise from `rng`).
+
+    Args:
+        p: actuator constants.
+        sensor: the orientation sensor's rate and noise.
+        program: the valve events (valve_program).
+        side_deg: side that was pressurised [deg], for the bending direction.
+        hold: deactuation instant [s], as in the program.
+        after: time simulated after the deactuation [s].
+        dt: RK4 step [s].
+        record_every: keep every record_every-th step.
+        rng: random generator of the sensor noise.
+
+    Returns:
+        The plant's and the sensor's samples of the run.
+    """
     sim = integrate(p, program, hold + after, dt, record_every)
     ts, euler = read(sensor, sim.t, sim.beta, rng)
     return Deactuation(sim, ts, bend_from_euler(euler), bend_direction(side_deg), hold)

@@ -21,7 +21,21 @@ Trajectory = Callable[[float], "np.ndarray | Target"]  # a position [m] or a who
 @dataclass(frozen=True)
 class PlanResult:
     """Time series of a tracking run: t [s], q [rad], x and x_ref [m], error and clearance [m]
-    (to obstacles and, with self-collision on, between checked link pairs)."""
+    (to obstacles and, with self-collision on, between checked link pairs).
+
+    Attributes:
+        t: time of each control period, shape (k,) [s].
+        q: joint positions commanded each period, shape (k, n) [rad].
+        x: end-effector position, shape (k, 3) [m].
+        x_ref: reference position, shape (k, 3) [m].
+        error: distance |x − x_ref|, shape (k,) [m].
+        clearance: smallest signed distance each period, shape (k,) [m]; inf: none checked.
+        planner_seconds: time spent in planner.step alone after the first period [s].
+        first_period_seconds: the first period's time [s]; it compiles or loads the kernels.
+        q0: the start, shape (n,) [rad]; None: the first step's speed is unknown.
+        orientation_error: orientation error, shape (k,) [rad], for a pose or axis task;
+            else None.
+    """
 
     t: np.ndarray
     q: np.ndarray
@@ -47,8 +61,17 @@ def track(
     """Follow `trajectory` from q0 [rad] for `duration` [s], one step per `dt` [s] of an
     OnlineController, the object a live loop uses.
 
-    A run of more than `max_steps` periods is refused before anything is allocated;
-    `progress(done, total)` is told about every hundredth of the run.
+    Args:
+        planner: the planner that computes each period's configuration.
+        trajectory: time [s] -> reference position (3,) [m] or a whole Target.
+        q0: start joint positions, shape (n,) [rad], checked by OnlineController.reset.
+        dt: control period [s].
+        duration: length of the run [s], at least dt.
+        max_steps: most periods allowed; a longer run is refused before anything is allocated.
+        progress: called as progress(done, total) every hundredth of the run; None: silent.
+
+    Returns:
+        The run's time series.
     """
     if not (np.isfinite(dt) and dt > 0):
         raise ConfigError("dt", f"must be finite and > 0 s (got {dt})")
@@ -107,6 +130,16 @@ def tracking_metrics(
     both without the first period, and that period's time (first_period_ms).
     For a pose or axis task also rms_ and max_orientation_error [rad] after `settle`, and with
     a `cone` [rad] the settled steps whose tool axis is outside it (cone_violations).
+
+    Args:
+        run: the tracking run.
+        robot: the robot, for its joint and speed limits.
+        settle: time after which the run counts as settled [s].
+        iterations: inner iterations (BAORNN) or solver calls (baselines) of the whole run.
+        cone: allowed angle of the tool axis from its target [rad]; None: not counted.
+
+    Returns:
+        Metric name -> value, in the units above (times in [µs] or [ms] as named).
     """
     settled = run.t >= settle
     late = run.error[settled]
@@ -139,7 +172,15 @@ def tracking_metrics(
 
 def max_speed_ratio(run: PlanResult, robot: RobotModel) -> float:
     """The largest |q̇_i| / (URDF speed limit of joint i) over the run, q̇ by finite
-    differences of the periods (from q0 when known); joints without a limit do not count."""
+    differences of the periods (from q0 when known); joints without a limit do not count.
+
+    Args:
+        run: the tracking run.
+        robot: the robot, for its joint speed limits.
+
+    Returns:
+        The largest speed ratio (above 1: a limit is broken); 0 for fewer than two samples.
+    """
     q = run.q if run.q0 is None else np.vstack([run.q0, run.q])
     if len(q) < 2 or len(run.t) < 2:
         return 0.0
@@ -150,7 +191,14 @@ def max_speed_ratio(run: PlanResult, robot: RobotModel) -> float:
 
 def trace_columns(run: PlanResult) -> dict[str, np.ndarray]:
     """The run as trace columns: t, q_1..q_m, x, y, z, x_ref, y_ref, z_ref, error, clearance,
-    and orientation_error [rad] for a pose or axis task."""
+    and orientation_error [rad] for a pose or axis task.
+
+    Args:
+        run: the tracking run.
+
+    Returns:
+        Column name -> its values, shape (k,), in the units of PlanResult.
+    """
     columns = {"t": run.t}
     columns.update({f"q_{j + 1}": run.q[:, j] for j in range(run.q.shape[1])})
     columns.update({"x": run.x[:, 0], "y": run.x[:, 1], "z": run.x[:, 2]})

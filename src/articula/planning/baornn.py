@@ -34,7 +34,16 @@ class BaornnParams(StrictModel):
 @dataclass
 class BeetleSearch:
     """What both BAORNN variants hold: the objective they search, their step constants, the
-    generator of all their randomness, and counts of objective evaluations and iterations."""
+    generator of all their randomness, and counts of objective evaluations and iterations.
+
+    Attributes:
+        objective: the objective g of Eq. (1.13) searched, with its scene and task.
+        params: the step constants of Algorithm 1.
+        rng: the generator of all the search's randomness (seed it for a reproducible run).
+        rate: joint speed (and acceleration) limits; None: unlimited, as in the book.
+        evaluations: objective evaluations so far.
+        iterations: iterations of Algorithm 1 so far.
+    """
 
     objective: Objective
     params: BaornnParams
@@ -78,12 +87,31 @@ class BeetleSearch:
 
 
 class Baornn(BeetleSearch):
-    """The faithful algorithm of Sect. 1.3.1; all randomness from the injected generator."""
+    """The faithful algorithm of Sect. 1.3.1; all randomness from the injected generator.
+
+    Attributes:
+        objective: the objective g of Eq. (1.13) searched, with its scene and task.
+        params: the step constants of Algorithm 1.
+        rng: the generator of all the search's randomness (seed it for a reproducible run).
+        rate: joint speed (and acceleration) limits; None: unlimited, as in the book.
+        evaluations: objective evaluations so far.
+        iterations: iterations of Algorithm 1 so far.
+    """
 
     def iterate(
         self, q: np.ndarray, g: float, target: Target | np.ndarray, t: float
     ) -> tuple[np.ndarray, float]:
-        """One iteration of Algorithm 1 from (q, g = g(q)); returns the accepted (q, g)."""
+        """One iteration of Algorithm 1 from (q, g = g(q)); returns the accepted (q, g).
+
+        Args:
+            q: joint angles of the current iterate, shape (nq,) [rad].
+            g: objective g(q) there (inf inside an obstacle).
+            target: the period's target, or a position, shape (3,) [m].
+            t: time of the period, placing moving obstacles [s].
+
+        Returns:
+            The accepted joint angles, shape (nq,) [rad], and their objective g.
+        """
         target = as_target(target)
         obj = self.objective
         b = self.rng.standard_normal(q.size)
@@ -108,7 +136,16 @@ class Baornn(BeetleSearch):
         return q, g
 
     def step(self, q: np.ndarray, target: Target | np.ndarray, t: float) -> np.ndarray:
-        """One control period: re-evaluate g for the new target, then iterate."""
+        """One control period: re-evaluate g for the new target, then iterate.
+
+        Args:
+            q: joint angles at the start of the period, shape (nq,) [rad].
+            target: the period's target, or a position, shape (3,) [m].
+            t: time of the period, placing moving obstacles [s].
+
+        Returns:
+            The joint angles at the end of the period, shape (nq,) [rad].
+        """
         target = as_target(target)
         obj, k, start = self.objective, self.params.iterations_per_step, q
         self._begin_period(q)

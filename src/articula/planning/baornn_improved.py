@@ -29,8 +29,15 @@ from articula.planning.task import Target, as_target
 
 
 class ImprovedParams(BaornnParams):
-    """BaornnParams with λ_k = c1·√e_k [rad/√m] instead of (1.23), `pairs`, the antenna pairs
-    per iteration, and `short_antenna`, the length of every second pair relative to λ_k [-]."""
+    """BaornnParams with λ_k = c1·√e_k instead of (1.23), several and shorter antenna pairs.
+
+    Attributes:
+        c1: antenna length λ_k = c1·√e_k, e_k the task error (not Eq. 1.23's g_k) [rad/√m].
+        c2: step δ_k = c2·λ_k, Eq. (1.24).
+        iterations_per_step: iterations per control period.
+        pairs: antenna pairs per iteration (at most the number of joints are used).
+        short_antenna: length of every second pair relative to λ_k, in (0, 1].
+    """
 
     pairs: Annotated[int, Field(ge=1, le=64)] = 3
     short_antenna: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.25
@@ -38,7 +45,16 @@ class ImprovedParams(BaornnParams):
 
 @dataclass
 class ImprovedBaornn(BeetleSearch):
-    """Algorithm 1 with the changes above; the same objective, projection and acceptance."""
+    """Algorithm 1 with the changes above; the same objective, projection and acceptance.
+
+    Attributes:
+        objective: the objective g of Eq. (1.13) searched, with its scene and task.
+        params: the step constants, with the antenna pairs.
+        rng: the generator of all the search's randomness (seed it for a reproducible run).
+        rate: joint speed (and acceleration) limits; None: unlimited, as in the book.
+        evaluations: objective evaluations so far.
+        iterations: iterations of Algorithm 1 so far.
+    """
 
     params: ImprovedParams
     _last_motion: np.ndarray | None = field(default=None, init=False)
@@ -46,7 +62,17 @@ class ImprovedBaornn(BeetleSearch):
     def iterate(
         self, q: np.ndarray, g: float, target: Target | np.ndarray, t: float
     ) -> tuple[np.ndarray, float]:
-        """One iteration from (q, g = g(q)); returns the accepted (q, g)."""
+        """One iteration from (q, g = g(q)); returns the accepted (q, g).
+
+        Args:
+            q: joint angles of the current iterate, shape (nq,) [rad].
+            g: objective g(q) there (inf inside an obstacle).
+            target: the period's target, or a position, shape (3,) [m].
+            t: time of the period, placing moving obstacles [s].
+
+        Returns:
+            The accepted joint angles, shape (nq,) [rad], and their objective g.
+        """
         target = as_target(target)
         obj, p = self.objective, self.params
         draw = self.rng.standard_normal((q.size, min(p.pairs, q.size)))
@@ -86,7 +112,16 @@ class ImprovedBaornn(BeetleSearch):
         self._last_motion = None
 
     def step(self, q: np.ndarray, target: Target | np.ndarray, t: float) -> np.ndarray:
-        """One control period: warm start, then iterate."""
+        """One control period: warm start, then iterate.
+
+        Args:
+            q: joint angles at the start of the period, shape (nq,) [rad].
+            target: the period's target, or a position, shape (3,) [m].
+            t: time of the period, placing moving obstacles [s].
+
+        Returns:
+            The joint angles at the end of the period, shape (nq,) [rad].
+        """
         target = as_target(target)
         start = q
         self._begin_period(q)

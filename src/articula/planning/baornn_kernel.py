@@ -57,8 +57,27 @@ def iterations(
     q, g, x_ref, orient, directions, c1, c2, lambda_weight, beta, d_min, lower, upper,
     arrays, static_min,
 ):  # fmt: skip
-    """Run one iteration of Algorithm 1 per row of `directions` (raw Gaussian draws, normalised
-    here); returns the accepted (q, g)."""
+    """Run one iteration of Algorithm 1 per row of `directions`; returns the accepted (q, g).
+
+    Args:
+        q: joint angles, shape (nq,) [rad].
+        g: objective g(q) there.
+        x_ref: reference position, shape (3,) [m].
+        orient: the task's orientation arguments (Objective.orient_arguments).
+        directions: raw Gaussian draws, one row per iteration, normalised here, shape (k, nq).
+        c1: antenna length constant of Eq. (1.23) [rad/√m].
+        c2: step constant of Eq. (1.24).
+        lambda_weight: penalty weight Λ of Eq. (1.7) [m^(1+β)].
+        beta: penalty exponent β of Eq. (1.7).
+        d_min: hard clearance of Eq. (1.12) [m].
+        lower: lower bound of the projection box, shape (nq,) [rad].
+        upper: upper bound of the projection box, shape (nq,) [rad].
+        arrays: compiled scene arrays with the pairs that count (CompiledClearance.arrays).
+        static_min: smallest distance of the pairs that never move, per kind, shape (2,) [m].
+
+    Returns:
+        The accepted joint angles, shape (nq,) [rad], and their objective g.
+    """
     for k in range(directions.shape[0]):
         b = directions[k] / math.sqrt(directions[k] @ directions[k])
         lam = c1 * math.sqrt(g) if math.isfinite(g) else c1  # Eq. (1.23)
@@ -81,7 +100,15 @@ def iterations(
 
 @jit()
 def antenna_scale(pair: int, short: float) -> float:
-    """Length of antenna pair `pair` relative to λ_k: every second pair is short."""
+    """Length of antenna pair `pair` relative to λ_k: every second pair is short.
+
+    Args:
+        pair: index of the antenna pair (0 first).
+        short: relative length of the short pairs.
+
+    Returns:
+        1 for an even pair, `short` for an odd one.
+    """
     return 1.0 if pair % 2 == 0 else short
 
 
@@ -105,8 +132,30 @@ def improved_period(
     """One control period of baornn-improved (planning/baornn_improved.py): g at q for the
     new reference (g_known instead when it is not NaN: a caller's g(q)), the warm start
     q + warm_motion (none when it is empty), then one iteration per draws[k], an
-    (n × pairs) Gaussian matrix whose orthonormalised columns are the antenna directions;
-    returns the accepted (q, g) and the number of objective evaluations."""
+    (n × pairs) Gaussian matrix whose orthonormalised columns are the antenna directions.
+
+    Args:
+        q: joint angles at the start of the period, shape (nq,) [rad].
+        g_known: the caller's g(q), or NaN to compute it here.
+        warm_motion: last period's joint motion, shape (nq,) [rad]; empty for no warm start.
+        x_ref: reference position, shape (3,) [m].
+        orient: the task's orientation arguments (Objective.orient_arguments).
+        draws: Gaussian draws, one matrix per iteration, shape (k, nq, pairs).
+        c1: antenna length constant, λ_k = c1·√e_k [rad/√m].
+        c2: step constant of Eq. (1.24).
+        short: relative length of every second antenna pair.
+        lambda_weight: penalty weight Λ of Eq. (1.7) [m^(1+β)].
+        beta: penalty exponent β of Eq. (1.7).
+        d_min: hard clearance of Eq. (1.12) [m].
+        lower: lower bound of the projection box, shape (nq,) [rad].
+        upper: upper bound of the projection box, shape (nq,) [rad].
+        arrays: compiled scene arrays with the pairs that count (CompiledClearance.arrays).
+        static_min: smallest distance of the pairs that never move, per kind, shape (2,) [m].
+
+    Returns:
+        The accepted joint angles, shape (nq,) [rad], their objective g, and the number of
+        objective evaluations.
+    """
     d, _, ee, ee_R = _evaluate(q, *arrays, static_min)
     e = _task_error(ee, ee_R, x_ref, orient)
     g = _penalised(e, d, lambda_weight, beta) if math.isnan(g_known) else g_known

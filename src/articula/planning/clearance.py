@@ -16,7 +16,13 @@ from articula.scene.scene import Scene
 @dataclass(frozen=True)
 class ClearanceRows:
     """Distances d [m] of the (link, obstacle) cells and checked link pairs within reach,
-    ∂d/∂q (rows, nq), and which rows are link pairs (self-collision)."""
+    ∂d/∂q (rows, nq), and which rows are link pairs (self-collision).
+
+    Attributes:
+        distance: clearance of each row, negative on overlap, shape (rows,) [m].
+        gradient: ∂d/∂q of each row, shape (rows, nq) [m/rad].
+        self_pair: True where the row is a pair of links, shape (rows,).
+    """
 
     distance: np.ndarray
     gradient: np.ndarray
@@ -25,8 +31,13 @@ class ClearanceRows:
 
 @dataclass(frozen=True)
 class EndEffector:
-    """The end effector at q: position x [m], rotation R (3×3, world) and Jacobian J (6 × nq,
-    world axes, linear rows first)."""
+    """The end effector at q: its position, rotation and Jacobian.
+
+    Attributes:
+        x: position in the world, shape (3,) [m].
+        R: rotation in the world, shape (3, 3).
+        J: Jacobian in world axes, linear rows first, shape (6, nq).
+    """
 
     x: np.ndarray
     R: np.ndarray
@@ -36,7 +47,12 @@ class EndEffector:
 class RowSource:
     """End-effector kinematics and clearance rows of a scene at q, in one compiled call where
     the scene allows it (CompiledClearance; for a period where a pair overlaps, or a scene it
-    does not cover, through Pinocchio and coal: the same quantities, to GJK's tolerance)."""
+    does not cover, through Pinocchio and coal: the same quantities, to GJK's tolerance).
+
+    Args:
+        scene: the robot, its obstacles and its checked link pairs.
+        use_compiled: try the compiled evaluation (False: always Pinocchio and coal).
+    """
 
     def __init__(self, scene: Scene, use_compiled: bool = True) -> None:
         self.scene = scene
@@ -45,7 +61,16 @@ class RowSource:
     def __call__(
         self, q: np.ndarray, t: float, influence: float
     ) -> tuple[EndEffector, ClearanceRows]:
-        """(the end effector, the rows closer than `influence` [m]) at q [rad], time t [s]."""
+        """(the end effector, the rows closer than `influence` [m]) at q [rad], time t [s].
+
+        Args:
+            q: joint angles, shape (nq,) [rad].
+            t: time, placing moving obstacles [s].
+            influence: distance below which a row counts [m].
+
+        Returns:
+            The end effector's kinematics and the clearance rows that move with q.
+        """
         if self.compiled is not None:
             self.compiled.at(t)
             out = compiled_rows.clearance_rows(self.compiled, q, influence)
@@ -73,6 +98,15 @@ def clearance_rows(scene: Scene, q: np.ndarray, t: float, influence: float) -> C
     closest point to the link's (flipped when the two overlap, so that ∇d still points toward
     more clearance) and J_p the Jacobian of the link's closest point; for links a and b,
     ∇d = n·(J_a − J_b) with n from b's closest point to a's.
+
+    Args:
+        scene: the robot, its obstacles and its checked link pairs.
+        q: joint angles, shape (nq,) [rad].
+        t: time, placing moving obstacles [s].
+        influence: distance below which a cell or pair counts [m].
+
+    Returns:
+        The distances, their gradients in joint space and which rows are link pairs.
     """
     robot = scene.robot
     distances, normals, flags = [], [], []

@@ -48,7 +48,27 @@ Quaternion = Annotated[list[Finite], Field(min_length=4, max_length=4)]
 
 
 class TrajectorySpec(StrictModel):
-    """[trajectory]: circle (Eq. 1.27), rectangle, waypoints or csv."""
+    """[trajectory]: circle (Eq. 1.27), rectangle, waypoints or csv.
+
+    Attributes:
+        type: the path's kind: "circle", "rectangle", "waypoints" or "csv".
+        center: centre C of the circle, shape (3,) [m].
+        axis_a: first in-plane unit axis A of the circle, shape (3,).
+        axis_b: second in-plane unit axis B of the circle, perpendicular to A, shape (3,).
+        radius: radius r of the circle [m].
+        period: time T of one lap (circle, rectangle) [s].
+        vertices: the rectangle's four corners, shape (4, 3) [m].
+        points: the waypoints, at least two, shape (k, 3) [m].
+        times: when each waypoint is reached, increasing, shape (k,) [s].
+        path: CSV file of t, x, y, z rows (and optionally an orientation), relative to the
+            scene file.
+        rpy: fixed tool orientation as roll, pitch, yaw about the world's x, y, z [rad].
+        quaternion: fixed tool orientation as a quaternion [w, x, y, z].
+        rpys: one roll, pitch, yaw per waypoint, interpolated by slerp [rad].
+        quaternions: one quaternion [w, x, y, z] per waypoint, interpolated by slerp.
+        axis: world direction the tool axis should point along (position+axis task), (3,).
+        cone: how far the tool axis may be from `axis`, in (0, π] [rad].
+    """
 
     type: Literal["circle", "rectangle", "waypoints", "csv"]
     center: Point | None = None
@@ -93,11 +113,36 @@ class TrajectorySpec(StrictModel):
 class PlannerSpec(StrictModel):
     """[planner]: the method and its parameters; keys a method does not use are ignored.
 
-    BAORNN (both): lambda_weight Λ, beta β (Eq. 1.11), d_min (1.12), c1, c2 (1.23-1.24),
-    iterations_per_step, seed; baornn-improved also `pairs` and `short_antenna`. Baselines:
-    gain K [1/s]; pinv/dls: repulsion η, influence [m], damping μ [m] (dls); qp: influence,
-    safety [m].
-    `seed` is also accepted at the top of a plan config, where it wins (see PlanConfig).
+    Attributes:
+        method: "baornn", "baornn-improved", or the baselines "pinv", "dls" and "qp".
+        lambda_weight: penalty weight Λ of Eq. (1.11), BAORNN [m^(1+β)].
+        beta: penalty exponent β of Eq. (1.11), BAORNN.
+        d_min: hard clearance of Eq. (1.12) [m].
+        dt: control period [s].
+        iterations_per_step: BAORNN iterations per control period.
+        duration: length of the run [s].
+        settle: time before rms_error and max_error are measured; default min(5, T/2) [s].
+        tolerance: rms_error above which the path counts as not tracked [m].
+        c1: antenna length constant of Eq. (1.23), BAORNN [rad/√m].
+        c2: step constant of Eq. (1.24), BAORNN.
+        pairs: antenna pairs per iteration, baornn-improved.
+        short_antenna: relative length of every second antenna pair, baornn-improved.
+        gain: K on the task error, baselines [1/s].
+        damping: μ of damped least squares, dls [m].
+        repulsion: η of the obstacle repulsion, pinv and dls [m²/s].
+        influence: distance below which an obstacle counts, baselines [m].
+        safety: distance d_s the qp's velocity dampers keep [m].
+        seed: seed of the planner's randomness; also accepted at the top of a plan config,
+            where it wins (see PlanConfig).
+        max_steps: most control periods a run may have (duration / dt).
+        limits: "velocity": the URDF's joint speed limits, scaled; "none": BAORNN moves as
+            fast as the book's Algorithm 1 (the baselines' solvers always keep them).
+        velocity_scale: fraction of the URDF joint speed limits, in (0, 1].
+        max_acceleration: joint acceleration limit for every joint; None: none [rad/s²].
+        task: what the end effector tracks: "position", "pose" or "position+axis"; without
+            an orientation or axis in the trajectory, the start's is held.
+        orientation_weight: BAORNN's weight on the orientation error [m/rad].
+        tool_axis: the tool axis in the end-effector frame, shape (3,).
     """
 
     method: Method = "baornn"
@@ -153,6 +198,14 @@ def make_planner(spec: PlannerSpec, scene: Scene, seed: int) -> Planner:
 
     The method's own parameter model checks what only it needs (a QP's safety distance inside
     its influence distance); its errors name the [planner] key.
+
+    Args:
+        spec: the validated [planner] table.
+        scene: the robot and obstacles to plan in.
+        seed: seed of the planner's random generator.
+
+    Returns:
+        The planner, ready for its first control period.
     """
     with fields_as(PARAMETER_KEYS):
         return _planner(spec, scene, seed)
@@ -185,7 +238,15 @@ def _planner(spec: PlannerSpec, scene: Scene, seed: int) -> Planner:
 
 def rate_limits(spec: PlannerSpec, robot: RobotModel) -> RateLimits | None:
     """The joint speed limits of `robot` (its URDF's, times velocity_scale; a joint without
-    one has none) and the acceleration limit a PlannerSpec asks for, or None for "none"."""
+    one has none) and the acceleration limit a PlannerSpec asks for.
+
+    Args:
+        spec: the validated [planner] table.
+        robot: the robot whose URDF velocity limits are scaled.
+
+    Returns:
+        The per-period limits, or None when spec.limits is "none".
+    """
     if spec.limits == "none":
         return None
     speeds = np.where(robot.velocity_limit > 0, robot.velocity_limit, np.inf)
@@ -205,14 +266,29 @@ PARAMETER_KEYS = (
 
 
 def make_trajectory(spec: TrajectorySpec, base_dir: Path) -> Circle | Waypoints:
-    """The reference path a TrajectorySpec names; a CSV path is relative to `base_dir`.
-    Errors name the [trajectory] key at fault."""
+    """The reference path a TrajectorySpec names; errors name the [trajectory] key at fault.
+
+    Args:
+        spec: the validated [trajectory] table.
+        base_dir: folder a relative CSV path is resolved from.
+
+    Returns:
+        The position path x_r(t) [m].
+    """
     with fields_as({name: f"trajectory.{name}" for name in TrajectorySpec.model_fields}):
         return _trajectory(spec, base_dir)
 
 
 def make_targets(spec: TrajectorySpec, base_dir: Path) -> TargetPath:
-    """The targets a TrajectorySpec names: its path, and its orientation and axis if given."""
+    """The targets a TrajectorySpec names: its path, and its orientation and axis if given.
+
+    Args:
+        spec: the validated [trajectory] table.
+        base_dir: folder a relative CSV path is resolved from.
+
+    Returns:
+        The target at each time: position, and orientation and tool axis if given.
+    """
     with fields_as({name: f"trajectory.{name}" for name in TrajectorySpec.model_fields}):
         path = _trajectory(spec, base_dir)
         rotations = None
@@ -244,7 +320,15 @@ def _trajectory(spec: TrajectorySpec, base_dir: Path) -> Circle | Waypoints:
 
 def absolute_paths(data: dict[str, Any], base_dir: Path) -> dict[str, Any]:
     """The config with its URDF, package folders, obstacle meshes and trajectory CSV made
-    absolute from `base_dir`, so that a run folder's config.toml still finds them."""
+    absolute from `base_dir`, so that a run folder's config.toml still finds them.
+
+    Args:
+        data: the config's tables as read from TOML (not modified).
+        base_dir: folder the relative paths are resolved from.
+
+    Returns:
+        A copy of the config with those paths absolute (package:// paths kept).
+    """
 
     def absolute(path: Any) -> Any:
         if not isinstance(path, str) or path.startswith(PACKAGE_URI):

@@ -24,6 +24,14 @@ class Objective:
     obstacles, Eq. (1.14) takes the largest penalty, i.e. the smallest distance over all of
     them. Beyond the book, a pose or axis `task` adds w · (orientation error) [m] to the
     tracking term (docs/deviations.md).
+
+    Attributes:
+        scene: the robot, its obstacles and its checked link pairs.
+        lambda_weight: penalty weight Λ [m^(1+β)] (0: no penalty).
+        beta: penalty exponent β.
+        d_min: hard clearance of Eq. (1.12) [m].
+        use_compiled: evaluate by CompiledClearance where the scene allows it.
+        task: what the end effector tracks, and the weight w of its orientation error.
     """
 
     scene: Scene
@@ -46,9 +54,16 @@ class Objective:
             object.__setattr__(self, "compiled", CompiledClearance.build(self.scene))
 
     def kernel_arguments(self, box: Box | None = None, t: float = 0.0) -> tuple:
-        """Λ, β, d_min, the projection box (default: the joint limits), the compiled scene
-        arrays with the pairs that count and their static minima, in the order of
-        planning.baornn_kernel (requires `compiled`), moving obstacles at time t [s]."""
+        """The objective's arguments to planning.baornn_kernel (requires `compiled`).
+
+        Args:
+            box: projection box (lower, upper), each shape (nq,) [rad]; None: the joint limits.
+            t: time, placing moving obstacles [s].
+
+        Returns:
+            (Λ, β, d_min, lower, upper, the compiled scene arrays with the pairs that count,
+            their static minima), in the order of planning.baornn_kernel.
+        """
         robot, c = self.scene.robot, self.compiled
         if c is None:
             raise ModelError("this scene has no compiled evaluation (see Objective.compiled)")
@@ -67,18 +82,38 @@ class Objective:
         return bool(self.scene.obstacles) and (self.lambda_weight > 0 or self.d_min > 0)
 
     def orient_arguments(self, target: Target) -> tuple:
-        """The task and the target's orientation as planning.baornn_kernel takes them."""
+        """The task and the target's orientation as planning.baornn_kernel takes them.
+
+        Args:
+            target: the period's target.
+
+        Returns:
+            (task code, weight, tool axis, reference rotation, reference axis).
+        """
         R_ref, axis_ref = target_arrays(self.task, target)
         return (self.task.code, self.task.weight, self.task.tool_axis, R_ref, axis_ref)
 
     def kinematics_arguments(self) -> tuple:
-        """The compiled scene arrays without any pair: forward kinematics only."""
+        """The compiled scene arrays without any pair: forward kinematics only.
+
+        Returns:
+            The arguments of the compiled evaluation after q, with no pair to check.
+        """
         if self.compiled is None:
             raise ModelError("this scene has no compiled evaluation (see Objective.compiled)")
         return self.compiled.arrays(self.compiled.no_pairs)
 
     def value(self, q: np.ndarray, target: Target | np.ndarray, t: float = 0.0) -> float:
-        """Objective g at configuration q [rad] for the target (or a position [m])."""
+        """Objective g at configuration q [rad] for the target (or a position [m]).
+
+        Args:
+            q: joint angles, shape (nq,) [rad].
+            target: the target, or a position, shape (3,) [m].
+            t: time, placing moving obstacles [s].
+
+        Returns:
+            The objective g; inf inside an obstacle when Λ > 0.
+        """
         target = as_target(target)
         if self.compiled is not None:
             self.compiled.at(t)
@@ -88,8 +123,16 @@ class Objective:
         return self._value(q, target, d)
 
     def tracking_error(self, q: np.ndarray, target: Target | np.ndarray) -> float:
-        """The task term of g alone: ||x_r − f(θ)|| [m], Eq. (1.5), plus the weighted
-        orientation error of a pose or axis task."""
+        """The task term of g alone: ||x_r − f(θ)||, Eq. (1.5), plus the weighted
+        orientation error of a pose or axis task.
+
+        Args:
+            q: joint angles, shape (nq,) [rad].
+            target: the target, or a position, shape (3,) [m].
+
+        Returns:
+            The task error e [m].
+        """
         target = as_target(target)
         if self.compiled is not None:
             _, _, ee, ee_R = self.compiled.evaluate(q, False, False)
@@ -111,7 +154,20 @@ class Objective:
         """(P_Ω(q), g there), Eqs. (1.17)-(1.18): clip to the joint limits (1.9), or to `box`
         (the joint limits narrowed by speed limits); if the clipped point is closer than d_min
         to an obstacle or touches itself (a checked link pair), stay at (q_current, g_current).
-        One distance query serves both the constraints and the penalty."""
+        One distance query serves both the constraints and the penalty.
+
+        Args:
+            q: candidate joint angles, shape (nq,) [rad].
+            q_current: joint angles kept if the candidate is infeasible, shape (nq,) [rad].
+            g_current: the objective at q_current.
+            target: the target, or a position, shape (3,) [m].
+            t: time, placing moving obstacles [s].
+            box: projection box (lower, upper), each shape (nq,) [rad]; None: the joint limits.
+
+        Returns:
+            The projected joint angles, shape (nq,) [rad], and g there; or q_current and
+            g_current.
+        """
         target = as_target(target)
         clipped = self.scene.robot.clip(q) if box is None else np.clip(q, *box)
         if self.compiled is not None:

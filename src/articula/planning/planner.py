@@ -34,7 +34,16 @@ class Planner(Protocol):
         ...
 
     def step(self, q: np.ndarray, target: Target, t: float) -> np.ndarray:
-        """The configuration [rad] for time t [s]."""
+        """The configuration [rad] for time t [s].
+
+        Args:
+            q: joint angles at the start of the period, shape (nq,) [rad].
+            target: the period's target.
+            t: time of the period, placing moving obstacles [s].
+
+        Returns:
+            The joint angles for time t, shape (nq,) [rad].
+        """
         ...
 
     def reset(self) -> None:

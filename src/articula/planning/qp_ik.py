@@ -22,13 +22,18 @@ from articula.validation import NonNegative, field_error
 class QpIkParams(RateParams):
     """min ½ λ_q |q̇|² + ½ λ_δ |δ|² s.t. J q̇ + δ = ẋ_r + K e, dampers, speed bounds.
 
-    Attributes (besides RateParams'):
-        joint_weight: λ_q [-]; slack_weight: λ_δ [-].
+    Attributes:
+        gain: K on the task error [1/s].
+        influence: distance d_i below which an obstacle's damper acts [m].
+        speed_scale: fraction of the URDF joint velocity limits.
+        joint_weight: λ_q.
+        slack_weight: λ_δ.
         damper_gain: ξ [m/s] (rad/s for joint limits).
         safety: d_s [m]; with influence d_i, ḋ ≥ −ξ (d − d_s)/(d_i − d_s) for d < d_i.
         self_safety: d_s for two links of the arm [m] (checked self-collision pairs): smaller,
             as some sit closer than `safety` by design.
-        limit_influence, limit_safety: the same damper on the distance to each joint limit [rad].
+        limit_influence: d_i of the same damper on the distance to each joint limit [rad].
+        limit_safety: d_s of the joint-limit damper [rad].
 
     The slack weight and the joint-limit damper were made stiffer and narrower in issue 13
     (docs/deviations.md): the earlier 100 and 0.2 / 0.02 rad gave up millimetres of tracking
@@ -57,7 +62,18 @@ class QpIkParams(RateParams):
 
 @dataclass
 class QpIk:
-    """The NEO-style controller on the same Scene distances and Jacobians, solved by daqp."""
+    """The NEO-style controller on the same Scene distances and Jacobians, solved by daqp.
+
+    Attributes:
+        scene: the robot, its obstacles and its checked link pairs.
+        dt: control period [s].
+        params: weights, gains and damper distances of the QP.
+        d_min: hard minimum clearance the start must respect (Eq. 1.12) [m].
+        task: what the end effector tracks.
+        use_compiled: take distances and kinematics from CompiledClearance where possible.
+        iterations: QP solves so far.
+        infeasible: periods whose QP had no solution (the arm stopped).
+    """
 
     scene: Scene
     dt: float
@@ -78,7 +94,16 @@ class QpIk:
         self._previous = None
 
     def step(self, q: np.ndarray, target: Target | np.ndarray, t: float) -> np.ndarray:
-        """One period: solve for q̇ (stop if the QP has no solution) and integrate for dt."""
+        """One period: solve for q̇ (stop if the QP has no solution) and integrate for dt.
+
+        Args:
+            q: joint angles at the start of the period, shape (nq,) [rad].
+            target: the period's target, or a position, shape (3,) [m].
+            t: time of the period, placing moving obstacles [s].
+
+        Returns:
+            The joint angles after dt, clipped to the joint limits, shape (nq,) [rad].
+        """
         qdot = self._solve(q, as_target(target), t)
         self.iterations += 1
         if qdot is None:

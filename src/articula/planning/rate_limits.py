@@ -34,7 +34,16 @@ class RateLimits:
     def box(
         self, q: np.ndarray, lower: np.ndarray, upper: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray]:
-        """The joint limits [lower, upper] narrowed to what one period can reach from q."""
+        """The joint limits [lower, upper] narrowed to what one period can reach from q.
+
+        Args:
+            q: joint positions at the start of the period, shape (nq,) [rad or m].
+            lower: lower joint limits, shape (nq,) [rad or m].
+            upper: upper joint limits, shape (nq,) [rad or m].
+
+        Returns:
+            The narrowed (lower, upper) bounds, each shape (nq,) [rad or m].
+        """
         reach = self.velocity * self.dt
         low, high = -reach, reach
         if self.acceleration is not None and self._last_motion is not None:
@@ -45,7 +54,11 @@ class RateLimits:
         return np.maximum(lower, q + low), np.minimum(upper, np.maximum(q + high, lower))
 
     def record(self, motion: np.ndarray) -> None:
-        """Remember the motion [rad] of the period that ended (for the acceleration limit)."""
+        """Remember the motion of the period that ended (for the acceleration limit).
+
+        Args:
+            motion: joint displacement over that period, shape (nq,) [rad or m].
+        """
         self._last_motion = np.array(motion, dtype=float)
 
     def reset(self) -> None:

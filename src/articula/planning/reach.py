@@ -27,6 +27,13 @@ def reach_sphere(robot: RobotModel) -> tuple[np.ndarray, float] | None:
     the last joint to the end effector) is fixed, so the end effector stays within their sum
     of the first joint's origin. A joint that translates (prismatic along an axis, PX/PY/PZ,
     or unaligned; planar; free) has no such bound.
+
+    Args:
+        robot: the arm, its end-effector frame included.
+
+    Returns:
+        The first joint's origin, shape (3,) [m], and the reach radius [m]; None when a
+        joint translates.
     """
     model, data = robot.model, robot.model.createData()
     if not all(joint.shortname() in ROTATING for joint in model.joints[1:]):
@@ -41,7 +48,16 @@ def reach_sphere(robot: RobotModel) -> tuple[np.ndarray, float] | None:
 def check_reach(
     robot: RobotModel, trajectory: Callable[[float], np.ndarray], duration: float
 ) -> None:
-    """InfeasibleError naming the first sampled time [s] at which the path is out of reach."""
+    """InfeasibleError naming the first sampled time [s] at which the path is out of reach.
+
+    The path is sampled at 2001 times over [0, duration]; an arm with a translating joint is
+    not checked.
+
+    Args:
+        robot: the arm, its end-effector frame included.
+        trajectory: reference position at time t, t [s] -> shape (3,) [m].
+        duration: length of the run [s].
+    """
     sphere = reach_sphere(robot)
     if sphere is None:
         return

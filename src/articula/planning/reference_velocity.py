@@ -35,6 +35,16 @@ def reference_velocity(
     and the feedback K [1/s] acts on the error against previous_ref, where the arm at x was
     meant to be: measuring it against x_ref as well would count the period's motion twice and
     leave a steady lag of one period's travel. Without a previous point: K (x_ref − x).
+
+    Args:
+        x_ref: reference point at the end of the period, shape (3,) [m].
+        previous_ref: reference point of the previous period, shape (3,) [m]; None: none.
+        x: end-effector position now, shape (3,) [m].
+        dt: control period [s].
+        gain: feedback gain K [1/s].
+
+    Returns:
+        The commanded end-effector velocity, shape (3,) [m/s].
     """
     if previous_ref is None:
         return gain * (x_ref - x)
@@ -58,6 +68,20 @@ def task_rows(
     ω = log(R_r R_r,prevᵀ)/dt + K log(R_r,prev Rᵀ), the same feed-forward and feedback on the
     rotation (world axes). Position+axis: the two rows of J_ω across the tool axis a, and
     there the rotation that takes a to the reference axis (its feed-forward likewise).
+
+    Args:
+        x: end-effector position, shape (3,) [m].
+        R: end-effector rotation in the world, shape (3, 3).
+        J: end-effector Jacobian, world axes, linear rows first, shape (6, nq).
+        task: what the end effector tracks.
+        target: the target at the end of the period.
+        previous: the previous period's target; None: no feed-forward.
+        dt: control period [s].
+        gain: feedback gain K [1/s].
+
+    Returns:
+        The task Jacobian, shape (rows, nq) (rows 3, 6 or 5), and its commanded velocity,
+        shape (rows,) [m/s, then rad/s].
     """
     v = reference_velocity(
         target.position, None if previous is None else previous.position, x, dt, gain
@@ -83,7 +107,15 @@ def task_rows(
 
 
 def rotation_vector(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """The rotation vector [rad] of the shortest rotation taking unit vector a to b."""
+    """The rotation vector of the shortest rotation taking unit vector a to b.
+
+    Args:
+        a: unit vector the rotation starts from, shape (3,).
+        b: unit vector it ends at, shape (3,).
+
+    Returns:
+        The axis times the angle, shape (3,) [rad]; zero when a and b are (anti)parallel.
+    """
     cross = np.cross(a, b)
     sine = float(np.linalg.norm(cross))
     angle = math.atan2(sine, float(a @ b))

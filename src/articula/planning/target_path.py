@@ -19,7 +19,12 @@ from articula.planning.trajectories import read_csv
 @dataclass(frozen=True)
 class WaypointRotations:
     """Orientations reached at increasing times [s], interpolated along the shortest rotation
-    (slerp) between them and held before the first and after the last."""
+    (slerp) between them and held before the first and after the last.
+
+    Attributes:
+        times: when each orientation is reached, increasing, shape (k,) [s].
+        slerp: scipy's interpolator through the orientations at those times.
+    """
 
     times: np.ndarray
     slerp: Slerp
@@ -28,8 +33,16 @@ class WaypointRotations:
     def create(
         cls, rotations: Sequence[np.ndarray], times: Sequence[float], field: str = "rpys"
     ) -> WaypointRotations:
-        """From one 3×3 rotation per time; times as the waypoints' (checked there); a count
-        that differs is a ConfigError naming `field`."""
+        """From one 3×3 rotation per time; a count that differs is a ConfigError naming `field`.
+
+        Args:
+            rotations: one rotation matrix (3×3, world) per time.
+            times: when each is reached, as the waypoints' (checked there) [s].
+            field: the config key named in an error.
+
+        Returns:
+            The interpolated orientations.
+        """
         t = np.asarray(times, dtype=float)
         if len(rotations) != len(t):
             raise ConfigError(field, f"needs {len(t)} orientations, one per point")
@@ -63,13 +76,27 @@ class TargetPath:
 
 
 def fixed_rotation(rotation: np.ndarray) -> Callable[[float], np.ndarray]:
-    """A constant orientation as a function of time."""
+    """A constant orientation as a function of time.
+
+    Args:
+        rotation: the orientation (3×3, world).
+
+    Returns:
+        A function of t [s] returning `rotation`.
+    """
     return lambda t: rotation
 
 
 def rotation_from(rpy: Sequence[float] | None, quaternion: Sequence[float] | None) -> np.ndarray:
-    """A rotation (3×3) from roll-pitch-yaw [rad] (about fixed x, y, z) or a quaternion
-    [w, x, y, z] (normalised here)."""
+    """A rotation from roll-pitch-yaw or a quaternion (the quaternion wins if both are given).
+
+    Args:
+        rpy: roll, pitch, yaw about the fixed x, y, z axes [rad]; None: use the quaternion.
+        quaternion: [w, x, y, z], normalised here; None: use rpy.
+
+    Returns:
+        The rotation matrix, shape (3, 3).
+    """
     if quaternion is not None:
         w, x, y, z = quaternion
         if np.linalg.norm(quaternion) < 1e-9:
@@ -81,8 +108,14 @@ def rotation_from(rpy: Sequence[float] | None, quaternion: Sequence[float] | Non
 
 
 def csv_rotations(path: Path) -> WaypointRotations | None:
-    """The orientations of a trajectory CSV's rows (roll, pitch, yaw or qw, qx, qy, qz
-    columns), or None when it has none."""
+    """The orientations of a trajectory CSV's rows (roll, pitch, yaw or qw, qx, qy, qz columns).
+
+    Args:
+        path: the trajectory CSV file.
+
+    Returns:
+        The orientations interpolated between the rows' times, or None when it has none.
+    """
     data = read_csv(path)
     names = data.dtype.names or ()
     columns = [n for n in names if n not in ("t", "x", "y", "z")]
@@ -98,5 +131,12 @@ def csv_rotations(path: Path) -> WaypointRotations | None:
 
 
 def axis_direction(axis: Sequence[float]) -> np.ndarray:
-    """A tool-axis direction from the [trajectory] table as a unit vector."""
+    """A tool-axis direction from the [trajectory] table as a unit vector.
+
+    Args:
+        axis: the direction in the world, any non-zero length, shape (3,).
+
+    Returns:
+        The unit direction, shape (3,).
+    """
     return unit(np.asarray(axis, dtype=float), "axis")

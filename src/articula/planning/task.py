@@ -18,9 +18,15 @@ KIND_CODES: dict[str, int] = {"position": 0, "pose": 1, "position+axis": 2}  # f
 
 @dataclass(frozen=True)
 class Target:
-    """One period's reference: position [m]; rotation (3×3, world) of the tool frame for a
-    pose task; unit world direction of the tool axis for a position+axis task. None: held
-    from the start (see OnlineController.reset)."""
+    """One period's reference for the end effector.
+
+    Attributes:
+        position: reference position, shape (3,) [m].
+        rotation: rotation of the tool frame (3×3, world) for a pose task; None: held from
+            the start (see OnlineController.reset).
+        axis: unit world direction of the tool axis for a position+axis task, shape (3,);
+            None: held from the start.
+    """
 
     position: np.ndarray
     rotation: np.ndarray | None = None
@@ -58,18 +64,41 @@ class Task:
     def orientation_error(self, rotation: np.ndarray, target: Target) -> float:
         """The orientation error [rad] of a tool frame with `rotation` (3×3, world): the angle
         of the rotation between it and the target's (pose), the angle between the tool axis
-        and the target's axis (position+axis), 0 for a position task."""
+        and the target's axis (position+axis), 0 for a position task.
+
+        Args:
+            rotation: the tool frame's rotation (3×3, world).
+            target: the target whose rotation or axis is the reference.
+
+        Returns:
+            The orientation error [rad].
+        """
         reference = target_arrays(self, target)
         return orientation_error(self.code, self.tool_axis, rotation, *reference)
 
 
 def as_target(target: Target | np.ndarray) -> Target:
-    """A Target as is; a position [m] as the Target of that position alone."""
+    """A Target as is; a position [m] as the Target of that position alone.
+
+    Args:
+        target: a Target, or a position, shape (3,) [m].
+
+    Returns:
+        The Target.
+    """
     return target if isinstance(target, Target) else Target(np.asarray(target, dtype=float))
 
 
 def unit(vector: np.ndarray | list[float], field_name: str) -> np.ndarray:
-    """`vector` as a unit 3-vector; ConfigError naming `field_name` for a zero or bad one."""
+    """`vector` as a unit 3-vector; ConfigError naming `field_name` for a zero or bad one.
+
+    Args:
+        vector: a non-zero 3-vector.
+        field_name: the config key named in an error.
+
+    Returns:
+        The unit vector, shape (3,).
+    """
     v = np.asarray(vector, dtype=float)
     norm = float(np.linalg.norm(v)) if v.shape == (3,) else 0.0
     if not (math.isfinite(norm) and norm > 1e-9):
@@ -79,7 +108,15 @@ def unit(vector: np.ndarray | list[float], field_name: str) -> np.ndarray:
 
 def target_arrays(task: Task, target: Target) -> tuple[np.ndarray, np.ndarray]:
     """(reference rotation, reference axis) of a target as arrays for the kernels; the one the
-    task does not use is a placeholder. ConfigError when the task needs one the target lacks."""
+    task does not use is a placeholder. ConfigError when the task needs one the target lacks.
+
+    Args:
+        task: the task, whose kind says which reference is needed.
+        target: the period's target.
+
+    Returns:
+        The reference rotation, shape (3, 3), and the reference axis, shape (3,).
+    """
     rotation = np.eye(3) if target.rotation is None else target.rotation
     axis = task.tool_axis if target.axis is None else target.axis
     if task.kind == "pose" and target.rotation is None:
@@ -93,7 +130,19 @@ def target_arrays(task: Task, target: Target) -> tuple[np.ndarray, np.ndarray]:
 def orientation_error(
     kind: int, tool_axis: np.ndarray, R: np.ndarray, R_ref: np.ndarray, axis_ref: np.ndarray
 ) -> float:
-    """Orientation error [rad] of rotation R against the reference (see Task)."""
+    """Orientation error of rotation R against the reference (see Task).
+
+    Args:
+        kind: the task's code: 0 position, 1 pose, 2 position+axis.
+        tool_axis: the tool axis in the end-effector frame, shape (3,).
+        R: the tool frame's rotation (3×3, world).
+        R_ref: reference rotation (3×3, world), used by a pose task.
+        axis_ref: reference unit axis in the world, shape (3,), used by a position+axis task.
+
+    Returns:
+        The angle between R and R_ref (pose), or between the tool axis and axis_ref
+        (position+axis), 0 for a position task [rad].
+    """
     if kind == 1:
         # The angle of R_refᵀ R from its trace; atan2 of the skew part keeps it exact near 0.
         trace = 0.0

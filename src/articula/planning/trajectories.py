@@ -26,7 +26,15 @@ def _positive(name: str, value: float) -> float:
 
 @dataclass(frozen=True)
 class Circle:
-    """x_r(t) = C + r cos(2πt/T) A + r sin(2πt/T) B, Eq. (1.27); A, B orthonormal."""
+    """x_r(t) = C + r cos(2πt/T) A + r sin(2πt/T) B, Eq. (1.27); A, B orthonormal.
+
+    Attributes:
+        center: centre C, shape (3,) [m].
+        axis_a: unit axis A, shape (3,).
+        axis_b: unit axis B, perpendicular to A, shape (3,).
+        radius: radius r [m].
+        period: time T of one lap [s].
+    """
 
     center: np.ndarray
     axis_a: np.ndarray
@@ -39,7 +47,18 @@ class Circle:
         cls, center: Sequence[float], axis_a: Sequence[float], axis_b: Sequence[float],
         radius: float, period: float,
     ) -> Circle:  # fmt: skip
-        """A validated circle: A and B must be perpendicular unit vectors."""
+        """A validated circle: A and B must be perpendicular unit vectors.
+
+        Args:
+            center: centre C, shape (3,) [m].
+            axis_a: unit axis A, shape (3,).
+            axis_b: unit axis B, perpendicular to A, shape (3,).
+            radius: radius r, > 0 [m].
+            period: time T of one lap, > 0 [s].
+
+        Returns:
+            The circle.
+        """
         a = _vector("axis_a", axis_a, (3,))
         b = _vector("axis_b", axis_b, (3,))
         if not (np.isclose(a @ a, 1) and np.isclose(b @ b, 1) and abs(a @ b) < 1e-9):
@@ -58,14 +77,27 @@ class Circle:
 
 @dataclass(frozen=True)
 class Waypoints:
-    """Straight lines between points [m] reached at increasing times [s]; held after the last."""
+    """Straight lines between points [m] reached at increasing times [s]; held after the last.
+
+    Attributes:
+        points: the waypoints, shape (k, 3) [m].
+        times: when each is reached, strictly increasing, shape (k,) [s].
+    """
 
     points: np.ndarray
     times: np.ndarray
 
     @classmethod
     def create(cls, points: Sequence[Sequence[float]], times: Sequence[float]) -> Waypoints:
-        """Validated waypoints: at least two, finite, times strictly increasing."""
+        """Validated waypoints: at least two, finite, times strictly increasing.
+
+        Args:
+            points: the waypoints, shape (k, 3) [m].
+            times: when each is reached, shape (k,) [s].
+
+        Returns:
+            The waypoints.
+        """
         p = np.asarray(points, dtype=float)
         t = np.asarray(times, dtype=float)
         if p.ndim != 2 or p.shape[1] != 3 or len(p) < 2:
@@ -81,7 +113,14 @@ class Waypoints:
     @classmethod
     def from_csv(cls, path: Path) -> Waypoints:
         """Waypoints from a CSV file with the header t,x,y,z (and optionally an orientation
-        per row, see read_csv)."""
+        per row, see read_csv).
+
+        Args:
+            path: the CSV file.
+
+        Returns:
+            The waypoints of its rows.
+        """
         data = read_csv(path)
         return cls.create(np.column_stack([data["x"], data["y"], data["z"]]), data["t"])
 
@@ -95,7 +134,14 @@ CSV_ORIENTATIONS = ({"roll", "pitch", "yaw"}, {"qw", "qx", "qy", "qz"})
 
 def read_csv(path: Path) -> np.ndarray:
     """The rows of a trajectory CSV as a structured array: columns t, x, y, z [s, m], and
-    optionally roll, pitch, yaw [rad] or qw, qx, qy, qz (the tool's orientation per row)."""
+    optionally roll, pitch, yaw [rad] or qw, qx, qy, qz (the tool's orientation per row).
+
+    Args:
+        path: the CSV file, with a header row.
+
+    Returns:
+        The rows, as a structured array with one named field per column.
+    """
     if not Path(path).is_file():
         raise ConfigError("path", f"{path}: file not found")
     try:
@@ -113,7 +159,15 @@ def read_csv(path: Path) -> np.ndarray:
 
 
 def rectangle(vertices: Sequence[Sequence[float]], period: float) -> Waypoints:
-    """The closed path through four vertices at constant speed, once per `period` [s]."""
+    """The closed path through four vertices at constant speed, once per `period`.
+
+    Args:
+        vertices: the four corners in order, shape (4, 3) [m].
+        period: time of one lap [s].
+
+    Returns:
+        The path as waypoints, back at the first vertex after one period.
+    """
     v = _vector("vertices", vertices, (4, 3))
     T = _positive("period", period)
     loop = np.vstack([v, v[:1]])

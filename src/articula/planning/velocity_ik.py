@@ -20,7 +20,10 @@ PINV_CUTOFF = 1e-6
 class VelocityIkParams(RateParams):
     """Gains of q̇ = J#(ẋ_r + K e) + (I − J⁺J) q̇_0.
 
-    Attributes (besides RateParams'; `influence` is d_i, beyond which nothing repels):
+    Attributes:
+        gain: K on the task error [1/s].
+        influence: distance d_i beyond which nothing repels [m].
+        speed_scale: fraction of the URDF joint velocity limits.
         damping: μ of DLS, J# = Jᵀ(JJᵀ + μ²I)⁻¹ [m].
         repulsion: η of the null-space term q̇_0 = η Σ (1/d − 1/d_i)/d² ∇d, the gradient of
             the classic FIRAS potential [m²/s].
@@ -32,8 +35,18 @@ class VelocityIkParams(RateParams):
 
 @dataclass
 class VelocityIk:
-    """Resolved-rate control of the end effector's task (position, pose or axis) at control
-    period dt [s]."""
+    """Resolved-rate control of the end effector's task (position, pose or axis).
+
+    Attributes:
+        scene: the robot, its obstacles and its checked link pairs.
+        method: "pinv" (Jacobian pseudo-inverse) or "dls" (damped least squares).
+        dt: control period [s].
+        params: gains of the control law.
+        d_min: hard minimum clearance the start must respect (Eq. 1.12) [m].
+        task: what the end effector tracks.
+        use_compiled: take distances and kinematics from CompiledClearance where possible.
+        iterations: control periods computed so far.
+    """
 
     scene: Scene
     method: Literal["pinv", "dls"]
@@ -54,7 +67,16 @@ class VelocityIk:
         self._previous = None
 
     def step(self, q: np.ndarray, target: Target | np.ndarray, t: float) -> np.ndarray:
-        """One period: integrate q̇ for dt and clip to the joint limits."""
+        """One period: integrate q̇ for dt and clip to the joint limits.
+
+        Args:
+            q: joint angles at the start of the period, shape (nq,) [rad].
+            target: the period's target, or a position, shape (3,) [m].
+            t: time of the period, placing moving obstacles [s].
+
+        Returns:
+            The joint angles after dt, shape (nq,) [rad].
+        """
         robot, p = self.scene.robot, self.params
         target = as_target(target)
         ee, rows = self._rows(q, t, p.influence)

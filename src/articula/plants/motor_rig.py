@@ -13,7 +13,17 @@ THETA, OMEGA, I_PRIMARY, I_SECONDARY = 0, 1, 2, 3
 
 
 def rig_matrices(p: MotorParams, dual: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Continuous (A, B) of the rig; inputs [V₁, V₂] (V₂ has no effect on the single rig)."""
+    """Continuous (A, B) of the rig; inputs (V₁, V₂) (V₂ has no effect on the single rig).
+
+    Args:
+        p: motor constants (Table 4.1 for the single rig, Table 4.2 for the dual one).
+        dual: True for the dual rig (a secondary motor, reversed, on the same shaft).
+
+    Returns:
+        A: state matrix, shape (n, n), states [θ [rad], ω [rad/s], i₁ [A]] and, with
+            `dual`, i₂ [A] (n = 3 or 4).
+        B: input matrix, shape (n, 2), inputs (V₁, V₂) [V].
+    """
     n = 4 if dual else 3
     A = np.zeros((n, n))
     B = np.zeros((n, 2))
@@ -37,7 +47,17 @@ def rig_matrices(p: MotorParams, dual: bool) -> tuple[np.ndarray, np.ndarray]:
 
 
 def discretize(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
-    """Exact zero-order-hold discretisation (Ad, Bd) for a sample time dt [s]."""
+    """Exact zero-order-hold discretisation (Ad, Bd) for a sample time dt [s].
+
+    Args:
+        A: continuous state matrix, shape (n, n).
+        B: continuous input matrix, shape (n, m).
+        dt: sample time [s].
+
+    Returns:
+        Ad: discrete state matrix exp(A dt), shape (n, n).
+        Bd: discrete input matrix for inputs held over each sample, shape (n, m).
+    """
     n, m = B.shape
     aug = np.zeros((n + m, n + m))
     aug[:n, :n] = A

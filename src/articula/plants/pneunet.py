@@ -24,7 +24,26 @@ from articula.validation import NonNegative, Positive, StrictModel, field_error
 
 
 class PneuNetParams(StrictModel):
-    """Constants of the simulated PneuNet in SI units, with the source or reason of each."""
+    """Constants of the simulated PneuNet in SI units, with the source or reason of each.
+
+    Attributes:
+        pwm_period: valve switching period T [s] (1/30 s, Sect. 2.4.1.2).
+        valve_tau: time constant τ_v of the valve's opening [s] (3τ_v = 0.2 s).
+        supply_pressure: pump pressure P_s, gauge [Pa].
+        chamber_tau: fill/vent time constant τ_p of the chamber [s] (calibrated).
+        theta_max: asymptote θ_max of the saturating pressure-to-angle map [rad].
+        pressure_scale: pressure scale p_c of that map, θ_eq = θ_max (1 − exp(−p/p_c)) [Pa].
+        natural_frequency: natural frequency ω_n of the bending [rad/s].
+        damping_ratio: damping ratio ζ of the bending, in (0, 1).
+        hysteresis: width of the play operator on the pressure [Pa]; 0: none.
+        sensor_zero: flex-sensor output at 0° [V].
+        sensor_gain: flex-sensor output per radian [V/rad].
+        sensor_noise: standard deviation of the flex sensor's angle noise [rad].
+        adc_bits: ADC resolution [bits]; 0: no quantisation.
+        adc_vref: ADC reference voltage [V].
+        trial_spread: relative standard deviation of the per-trial scales of supply pressure,
+            chamber τ and bending reach (clipped to [0.5, 1.5]).
+    """
 
     # Valve switching period, Sect. 2.4.1.2: T = 1/30 s.
     pwm_period: Positive = 1.0 / 30.0  # [s]
@@ -70,20 +89,48 @@ class PneuNetParams(StrictModel):
     def equilibrium_angle(
         self, pressure: np.ndarray, reach: np.ndarray | float = 1.0
     ) -> np.ndarray:
-        """Static bending angle [rad] at chamber pressure [Pa] (saturating map), × reach."""
+        """Static bending angle [rad] at chamber pressure [Pa] (saturating map), × reach.
+
+        Args:
+            pressure: chamber gauge pressure, any shape [Pa]; negative counts as 0.
+            reach: scale of the bending reach (a trial factor), broadcast with `pressure`.
+
+        Returns:
+            The equilibrium angle θ_eq, shaped as `pressure` [rad].
+        """
         theta = self.theta_max * -np.expm1(-np.maximum(pressure, 0.0) / self.pressure_scale)
         return reach * theta
 
     def trial_factors(self, rng: np.random.Generator) -> np.ndarray:
-        """Scales of [supply pressure, chamber τ, bending reach] for one trial."""
+        """Scales of [supply pressure, chamber τ, bending reach] for one trial.
+
+        Args:
+            rng: random generator of the trial's draw.
+
+        Returns:
+            The three scales, shape (3,), each 1 + trial_spread·N(0, 1) clipped to [0.5, 1.5].
+        """
         return np.clip(1.0 + self.trial_spread * rng.standard_normal(3), 0.5, 1.5)
 
 
 class PneuNetBatch:
     """State of `trials` actuators at rest, advanced one PWM period at a time.
 
-    factors: (trials, 3) scales of supply pressure, chamber τ and bending reach per trial
-    (PneuNetParams.trial_factors); None: the nominal actuator for every trial.
+    Args:
+        params: the actuator's constants.
+        trials: number of actuators simulated side by side (>= 1).
+        factors: scales of supply pressure, chamber τ and bending reach per trial, shape
+            (trials, 3) (PneuNetParams.trial_factors); None: the nominal actuator for all.
+
+    Attributes:
+        supply: supply pressure of each trial, shape (trials,) [Pa].
+        chamber_tau: chamber time constant of each trial, shape (trials,) [s].
+        reach: bending-reach scale of each trial, shape (trials,).
+        valve: valve opening, shape (trials,), in [0, 1].
+        pressure: chamber gauge pressure, shape (trials,) [Pa].
+        played: pressure after the play operator, shape (trials,) [Pa].
+        theta: bending angle, shape (trials,) [rad].
+        omega: bending rate, shape (trials,) [rad/s].
     """
 
     def __init__(
@@ -112,7 +159,11 @@ class PneuNetBatch:
         self.omega = np.zeros(trials)  # [rad/s]
 
     def advance(self, duty: np.ndarray) -> None:
-        """Apply `duty` in [0, 1] (one per trial) for one PWM period."""
+        """Apply `duty` in [0, 1] (one per trial) for one PWM period.
+
+        Args:
+            duty: valve duty cycle of each trial, shape (trials,); clipped to [0, 1].
+        """
         p = self.params
         d = np.minimum(np.maximum(duty, 0.0), 1.0)
         T = p.pwm_period
@@ -160,14 +211,28 @@ class PneuNetBatch:
         self.valve = command + x0 * ev
 
     def read_code(self, noise: np.ndarray) -> np.ndarray:
-        """The flex sensor's ADC code (adc_bits > 0): the divider's volts with noise, floored."""
+        """The flex sensor's ADC code (adc_bits > 0): the divider's volts with noise, floored.
+
+        Args:
+            noise: standard normal draws, one per trial, shape (trials,).
+
+        Returns:
+            The codes, shape (trials,), in [0, 2^adc_bits − 1] (as floats).
+        """
         p = self.params
         volts = p.sensor_zero + p.sensor_gain * (self.theta + p.sensor_noise * noise)
         lsb = p.adc_vref / 2**p.adc_bits
         return np.minimum(np.maximum(np.floor(volts / lsb), 0), 2**p.adc_bits - 1)
 
     def read(self, noise: np.ndarray) -> np.ndarray:
-        """Flex-sensor angle [rad] as the controller reads it: noise, 10-bit ADC, back to angle."""
+        """Flex-sensor angle [rad] as the controller reads it: noise, the ADC, back to angle.
+
+        Args:
+            noise: standard normal draws, one per trial, shape (trials,).
+
+        Returns:
+            The measured bending angle of each trial, shape (trials,) [rad].
+        """
         p = self.params
         if p.adc_bits:
             volts = (self.read_code(noise) + 0.5) * (p.adc_vref / 2**p.adc_bits)  # mid-step

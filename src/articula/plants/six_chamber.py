@@ -34,6 +34,25 @@ class SixChamberParams(StrictModel):
     datasheet's E. supply is the pump's gauge pressure; orifice_diameter, discharge and
     flow_transition describe each 3/3 valve's orifice; polytropic is the index n of the air;
     stiffening makes the body stiffer with chamber pressure, V E k²·(1 + s Σ p_i⁺/supply).
+
+    Attributes:
+        length: body length L [m] (book).
+        outer_radius: outer radius of the body [m] (book).
+        chamber_radius: radius of each chamber [m] (book).
+        chamber_circle: radius r_p of the circle of chamber centres [m].
+        chamber_length: chamber length L_c [m], at most `length`.
+        density: density of the silicone [kg/m³].
+        sensor_mass: mass of the orientation sensor and its radio on the top [kg].
+        youngs_modulus: Young's modulus E of the silicone [Pa], calibrated.
+        damping: bending damping b [N·m·s/rad], calibrated.
+        supply: pump pressure, gauge [Pa].
+        atmosphere: atmospheric pressure, absolute [Pa].
+        temperature: air temperature T [K].
+        polytropic: polytropic index n of the chamber air, in [1, 1.4].
+        orifice_diameter: diameter of each valve's orifice [m].
+        discharge: discharge coefficient of the orifice, in (0, 1].
+        flow_transition: pressure difference below which orifice flow turns linear [Pa].
+        stiffening: relative rise s of V E k² per chamber at full supply; 0: none.
     """
 
     length: Positive = 0.10  # [m]
@@ -145,28 +164,64 @@ class SixChamberParams(StrictModel):
 
 
 def chamber_directions() -> np.ndarray:
-    """Unit vectors ê_i (6, 2) of the chambers, chamber i at 60°·i."""
+    """Unit vectors ê_i (6, 2) of the chambers, chamber i at 60°·i.
+
+    Returns:
+        The in-plane direction of each chamber, shape (6, 2).
+    """
     phi = np.radians(60.0 * np.arange(CHAMBERS))
     return np.column_stack([np.cos(phi), np.sin(phi)])
 
 
 def volume_gradients(p: SixChamberParams) -> np.ndarray:
-    """a_i = ∂V_i/∂β (6, 2) [m³/rad]: a chamber grows when the body bends away from it."""
+    """a_i = ∂V_i/∂β (6, 2) [m³/rad]: a chamber grows when the body bends away from it.
+
+    Args:
+        p: actuator constants.
+
+    Returns:
+        a_i = −A_c r_p (L_c/L) ê_i for each chamber, shape (6, 2) [m³/rad].
+    """
     return -p.lever * chamber_directions()
 
 
 def static_bend(p: SixChamberParams, gauge: np.ndarray) -> np.ndarray:
-    """β [rad] at rest under chamber gauge pressures [Pa], volume changes ignored (Sect. 3.2.2)."""
+    """β [rad] at rest under chamber gauge pressures [Pa], volume changes ignored (Sect. 3.2.2).
+
+    Args:
+        p: actuator constants.
+        gauge: gauge pressure of each chamber, shape (6,) [Pa].
+
+    Returns:
+        The static bending vector β, shape (2,) [rad], from V E k² θ = V E c P.
+    """
     return volume_gradients(p).T @ np.asarray(gauge, dtype=float) / p.stiffness  # V E k²θ = V E c P
 
 
 def gas_stiffness(p: SixChamberParams, sealed_absolute: float) -> float:
-    """Bending stiffness [N·m/rad] added by six sealed chambers at one absolute pressure [Pa]."""
+    """Bending stiffness [N·m/rad] added by six sealed chambers at one absolute pressure [Pa].
+
+    Args:
+        p: actuator constants.
+        sealed_absolute: absolute pressure of every sealed chamber [Pa].
+
+    Returns:
+        The gas spring's bending stiffness 3 n p (A_c r_p L_c/L)² / V_0 [N·m/rad].
+    """
     # dp_i = −n p a_i·dβ / V_0 on each chamber; Σ a_i a_iᵀ = 3 (A_c r_p)² I₂.
     return 3 * p.polytropic * sealed_absolute * p.lever**2 / p.chamber_volume
 
 
 def natural_frequency(p: SixChamberParams, sealed: bool = False) -> tuple[float, float]:
-    """(ω_n [rad/s], ζ) of I θ'' + b θ' + K θ = 0; `sealed` adds the chambers' gas spring."""
+    """(ω_n [rad/s], ζ) of I θ'' + b θ' + K θ = 0; `sealed` adds the chambers' gas spring.
+
+    Args:
+        p: actuator constants.
+        sealed: add the stiffness of the six chambers sealed at atmospheric pressure.
+
+    Returns:
+        omega_n: undamped natural frequency ω_n [rad/s].
+        zeta: damping ratio ζ.
+    """
     K = p.stiffness + (gas_stiffness(p, p.atmosphere) if sealed else 0.0)
     return math.sqrt(K / p.inertia), p.damping / (2 * math.sqrt(K * p.inertia))

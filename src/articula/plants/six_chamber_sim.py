@@ -28,9 +28,15 @@ Event = tuple[float, int, int] | tuple[float, int, int, float]
 
 @dataclass(frozen=True)
 class ValveSchedule:
-    """Valve commands: at times[k] [s] chamber chambers[k] goes to position modes[k].
+    """Valve commands: at `times[k]` [s] chamber `chambers[k]` goes to position `modes[k]`.
 
-    targets[k] [Pa, gauge] is the pressure a REGULATE event holds (unused by other modes).
+    `targets[k]` (gauge) [Pa] is the pressure a REGULATE event holds (unused by other modes).
+
+    Attributes:
+        times: event times, sorted, shape (k,) [s].
+        chambers: chamber index 0-5 of each event, shape (k,).
+        modes: valve mode of each event (VENT, HOLD, FILL or REGULATE), shape (k,).
+        targets: REGULATE target of each event, gauge, shape (k,) [Pa]; 0 for other modes.
     """
 
     times: np.ndarray
@@ -43,7 +49,15 @@ class ValveSchedule:
         events: list[tuple[float, int, int] | tuple[float, int, int, float]],
     ) -> ValveSchedule:
         """A schedule from (time [s], chamber, mode[, target gauge Pa]) tuples, sorted by time
-        (stable); REGULATE events need a target above 0."""
+        (stable); REGULATE events need a target above 0.
+
+        Args:
+            events: (time [s], chamber 0-5, mode) or (time [s], chamber, REGULATE, target
+                gauge pressure [Pa]) tuples, in any order.
+
+        Returns:
+            The checked schedule, events sorted by time.
+        """
         full = [(*e, 0.0) if len(e) == 3 else tuple(e) for e in events]
         for k, (t, chamber, mode, target) in enumerate(full):
             if not (0 <= chamber < CHAMBERS):
@@ -72,7 +86,15 @@ class ValveSchedule:
 @dataclass(frozen=True)
 class Simulation:
     """Recorded samples: t [s], β (n, 2) [rad], rate β' (n, 2) [rad/s], gauge pressures
-    (n, 6) [Pa] and valve modes (n, 6) (VENT, HOLD, FILL or REGULATE)."""
+    (n, 6) [Pa] and valve modes (n, 6) (VENT, HOLD, FILL or REGULATE).
+
+    Attributes:
+        t: sample times, shape (n,) [s].
+        beta: bending vector β, shape (n, 2) [rad].
+        rate: bending rate β', shape (n, 2) [rad/s].
+        gauge: chamber gauge pressures, shape (n, 6) [Pa].
+        modes: valve mode of each chamber (VENT, HOLD, FILL or REGULATE), shape (n, 6).
+    """
 
     t: np.ndarray
     beta: np.ndarray
@@ -102,8 +124,18 @@ def integrate(
 ) -> Simulation:
     """Integrate from rest at atmospheric pressure (or β0, β'0) by RK4 with step dt [s].
 
-    duration [s] > 0; every record_every-th step is kept; modes0 (6,) are the valves' initial
-    positions (VENT, HOLD or FILL; all VENT by default).
+    Args:
+        p: actuator constants.
+        schedule: the valve events.
+        duration: simulated time [s], > 0.
+        dt: RK4 step [s], in (0, 1e-3].
+        record_every: keep every record_every-th step (>= 1).
+        beta0: initial bending vector β [rad].
+        rate0: initial bending rate β' [rad/s].
+        modes0: initial valve positions, shape (6,) (VENT, HOLD or FILL); None: all VENT.
+
+    Returns:
+        The recorded samples, from t = 0 to `duration`.
     """
     if not (0 < dt <= 1e-3):
         raise ConfigError("dt", f"need 0 < dt <= 1e-3 s (got {dt})")
@@ -129,7 +161,15 @@ def integrate(
 
 class Stepper:
     """The actuator from rest advanced one RK4 step at a time with valve positions given
-    each step (a firmware's pins), exactly as `integrate` advances it between events."""
+    each step (a firmware's pins), exactly as `integrate` advances it between events.
+
+    Args:
+        p: actuator constants.
+        dt: RK4 step [s].
+
+    Attributes:
+        y: state [β (2) [rad], β' (2) [rad/s], absolute chamber pressures (6) [Pa]], shape (10,).
+    """
 
     def __init__(self, p: SixChamberParams, dt: float = 1e-4) -> None:
         self.p, self.dt = p, dt
@@ -143,7 +183,11 @@ class Stepper:
         return self.y[0:2]
 
     def advance(self, modes: np.ndarray) -> None:
-        """One step dt with the valves at `modes` (6,) (VENT, HOLD or FILL)."""
+        """One step dt with the valves at `modes` (6,) (VENT, HOLD or FILL).
+
+        Args:
+            modes: valve position of each chamber, shape (6,).
+        """
         _, ys, _ = _integrate(self.y, np.array(modes, np.int64), self._c, self._a, *self._none,
                               self.dt, 1, 1)  # fmt: skip
         self.y = ys[-1]
@@ -151,7 +195,18 @@ class Stepper:
 
 @jit(error_model="numpy")
 def orifice_flow(upstream: float, downstream: float, rt: float, cda: float, trans: float) -> float:
-    """Mass flow [kg/s] through an orifice, sharp-edged above `trans` [Pa], linear below."""
+    """Mass flow [kg/s] through an orifice, sharp-edged above `trans` [Pa], linear below.
+
+    Args:
+        upstream: absolute pressure on the source side [Pa].
+        downstream: absolute pressure on the receiving side [Pa].
+        rt: specific gas constant times temperature, R T [J/kg].
+        cda: discharge coefficient times orifice area [m²].
+        trans: pressure difference of the turbulent-to-linear transition [Pa].
+
+    Returns:
+        The mass flow from upstream to downstream [kg/s], negative when it reverses.
+    """
     dp = upstream - downstream
     rho = max(upstream, downstream) / rt  # density on the high side, ideal gas
     return cda * math.sqrt(2.0 * rho) * dp / (dp * dp + trans * trans) ** 0.25
@@ -229,6 +284,14 @@ def fill_time(p: SixChamberParams, gauge: float, dt: float = 1e-5) -> float:
 
     The firmware sets a pressure by the fill valve's open time (Sect. 3.2.3: expansion grows
     with the open time); this is that time for the modelled orifice. inf at or above supply.
+
+    Args:
+        p: actuator constants.
+        gauge: target gauge pressure [Pa].
+        dt: integration step [s].
+
+    Returns:
+        The open time [s]; 0 for gauge <= 0, inf at or above the supply pressure.
     """
     if gauge <= 0:
         return 0.0

@@ -36,13 +36,31 @@ class Device(Protocol):
 
     info: Info
 
-    def configure(self, kind: int, body: bytes) -> None: ...
+    def configure(self, kind: int, body: bytes) -> None:
+        """Take a rig-specific command (SET_GAINS, SET_REFERENCE, ...); DeviceError refuses it.
 
-    def start(self, duration: float, seed: int) -> None: ...
+        Args:
+            kind: the command's message type (a `Kind`).
+            body: the command's body (docs/protocol.md).
+        """
 
-    def sample(self) -> np.ndarray | None: ...
+    def start(self, duration: float, seed: int) -> None:
+        """Begin a run from rest.
 
-    def stop(self) -> None: ...
+        Args:
+            duration: the run's length [s].
+            seed: the noise seed the sensor's noise is drawn from.
+        """
+
+    def sample(self) -> np.ndarray | None:
+        """The run's next sample.
+
+        Returns:
+            One value per channel of `info`, shape (channels,); None when the run is over.
+        """
+
+    def stop(self) -> None:
+        """End the run now (actuators off)."""
 
 
 class PlayedRun:
@@ -58,7 +76,11 @@ class PlayedRun:
         self._compute, self._rows, self._n = compute, None, 0
 
     def sample(self) -> np.ndarray | None:
-        """The run's next sample; None when it is over."""
+        """The run's next sample.
+
+        Returns:
+            The next row of the simulated run, shape (channels,); None when it is over.
+        """
         if self._rows is None:
             self._rows = self._compute()
         if self._n >= len(self._rows):
@@ -73,7 +95,14 @@ class PlayedRun:
 
 @dataclass(frozen=True)
 class Faults:
-    """Faults injected on the device's side of the line (module docstring)."""
+    """Faults injected on the device's side of the line (module docstring).
+
+    Attributes:
+        drop: probability that a device frame is not sent, in [0, 1).
+        corrupt: probability that one bit of a device frame is flipped, in [0, 1).
+        delay_ms: latency of every reply to a command [ms].
+        reset_at: run time at which the device restarts [s]; None: never.
+    """
 
     drop: float = 0.0
     corrupt: float = 0.0
@@ -82,7 +111,14 @@ class Faults:
 
     @classmethod
     def parse(cls, text: str) -> Faults:
-        """Faults from "drop=0.01,corrupt=0.01,delay_ms=20,reset_at=5.0" (any of them)."""
+        """Faults from "drop=0.01,corrupt=0.01,delay_ms=20,reset_at=5.0" (any of them).
+
+        Args:
+            text: comma-separated name=value pairs (the `--faults` option); "" for none.
+
+        Returns:
+            The faults, the ones not named at their defaults (none).
+        """
         values: dict[str, float] = {}
         for item in filter(None, (part.strip() for part in text.split(","))):
             name, _, value = item.partition("=")
@@ -103,7 +139,14 @@ class Faults:
 
 
 class Emulator:
-    """A device behind a pty; `path` is what the host opens. serve() answers until stop()."""
+    """A device behind a pty; `path` is what the host opens. serve() answers until stop().
+
+    Args:
+        device: the rig's program that answers the commands and makes the samples.
+        realtime: pace samples at the rig's sample period (default: as fast as the host reads).
+        faults: faults injected on the device's frames; None: none.
+        seed: seed of the faults' random draws.
+    """
 
     def __init__(
         self, device: Device, realtime: bool = False, faults: Faults | None = None, seed: int = 0
@@ -145,7 +188,11 @@ class Emulator:
                 self._step()
 
     def start(self) -> Emulator:
-        """serve() on a daemon thread; returns the emulator."""
+        """serve() on a daemon thread.
+
+        Returns:
+            The emulator itself.
+        """
         self._thread = threading.Thread(target=self.serve, name="articula-emulator", daemon=True)
         self._thread.start()
         return self

@@ -27,7 +27,18 @@ BUILD_HINT = "build it with: make -C firmware (needs apt-get install -y gcc-avr 
 
 
 class Pins(NamedTuple):
-    """The firmware's outputs at the start of a control period, as the harness reads them."""
+    """The firmware's outputs at the start of a control period, as the harness reads them.
+
+    Attributes:
+        adc_channel: the ADC channel the starting conversion reads (255: a tick, no conversion).
+        porta: PORTA register: H-bridge direction and valve pins.
+        portc: PORTC register: valve pins.
+        porth: PORTH register: the PneuNet's pump pin.
+        ocr1a: Timer1's PWM compare register (duty) [counts].
+        ocr3a: Timer3's PWM compare register (duty) [counts].
+        ocr4a: Timer4's PWM compare register (duty) [counts].
+        step_cycles: CPU cycles the previous control step took.
+    """
 
     adc_channel: int  # the channel the starting conversion reads (255: a tick, none)
     porta: int  # port registers: direction and valve pins
@@ -40,7 +51,13 @@ class Pins(NamedTuple):
 
 
 class Inputs(NamedTuple):
-    """What the plant puts on the firmware's inputs for the period that starts."""
+    """What the plant puts on the firmware's inputs for the period that starts.
+
+    Attributes:
+        adc_code: the code the starting ADC conversion reads [counts].
+        encoder_count: where the quadrature encoder on D2/D3 goes [counts].
+        serial1: the bytes a sensor sends on Serial1 now.
+    """
 
     adc_code: int = 0  # what the starting conversion reads
     encoder_count: int = 0  # where the quadrature encoder on D2/D3 goes
@@ -53,11 +70,22 @@ class PinPlant(Protocol):
     tick_us: int | None  # the plant's own step [µs]; None: a step per ADC conversion
 
     def start(self, seed: int) -> None:
-        """A run starts: the plant at rest, its noise drawn from `seed`."""
+        """A run starts: the plant at rest, its noise drawn from `seed`.
+
+        Args:
+            seed: the run's noise seed (START's).
+        """
 
     def period(self, pins: Pins) -> Inputs:
         """One control period: the outputs `pins` held since the last call act on the plant
-        (none before the first); returns its inputs at the period's start."""
+        (none before the first).
+
+        Args:
+            pins: the firmware's outputs as the harness reads them now (held since the last call).
+
+        Returns:
+            The plant's inputs to the firmware at the period's start.
+        """
 
 
 class FirmwareRig:

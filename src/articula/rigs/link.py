@@ -32,7 +32,14 @@ class DeviceResetError(DeviceError):
 @dataclass
 class LinkStats:
     """What the line lost: damaged frames, device frames missing from the sequence, commands
-    sent again for want of an acknowledgement."""
+    sent again for want of an acknowledgement.
+
+    Attributes:
+        crc_errors: frames dropped as damaged (malformed COBS block or CRC mismatch).
+        dropped: device frames missing from the device's sequence numbers.
+        resends: commands sent again for want of an ACK or ERROR.
+        frames: device frames received intact.
+    """
 
     crc_errors: int = 0
     dropped: int = 0
@@ -41,7 +48,17 @@ class LinkStats:
 
 
 class Link:
-    """A rig behind `port` (a device path, or any pyserial URL); `expect` checks its kind."""
+    """A rig behind `port` (a device path, or any pyserial URL); `expect` checks its kind.
+
+    Opening it shakes hands (HELLO, INFO): `info` is what is on the other end.
+
+    Args:
+        port: the serial port: a device path (/dev/ttyACM0, an emulator's pty) or a pyserial URL.
+        expect: the rig kind the caller needs (PortError for another); None: any.
+        baud: the line's rate [bit/s].
+        timeout: wait for a command's ACK or ERROR before sending it again [s].
+        retries: resends of a command before the link gives up (DeviceError).
+    """
 
     def __init__(
         self,
@@ -69,7 +86,14 @@ class Link:
             raise
 
     def handshake(self, expect: RigKind | None) -> Info:
-        """HELLO, and the INFO that answers it checked against `expect` and our protocol."""
+        """HELLO, and the INFO that answers it checked against `expect` and our protocol.
+
+        Args:
+            expect: the rig kind required (PortError for another); None: any.
+
+        Returns:
+            The device's handshake.
+        """
         self._expecting_info = True
         try:
             info = protocol.decode_info(self._exchange(Kind.HELLO, b"", answer=Kind.INFO).body)
@@ -86,17 +110,28 @@ class Link:
         return info
 
     def command(self, kind: Kind, body: bytes = b"", fresh: bool = False) -> int:
-        """Send one command and wait for its acknowledgement (resent on silence); returns
-        the command's sequence number (a DONE names its START by it). `fresh`: first forget
-        the device frames taken in and not asked for (a run's START: they belong to an
-        earlier run)."""
+        """Send one command and wait for its acknowledgement (resent on silence).
+
+        Args:
+            kind: the command's message type.
+            body: the command's body (docs/protocol.md).
+            fresh: first forget the device frames taken in and not asked for (a run's START:
+                they belong to an earlier run).
+
+        Returns:
+            The command's sequence number (a DONE names its START by it).
+        """
         if fresh:
             self.inbox.clear()
         self._exchange(kind, body, answer=Kind.ACK)
         return self._seq
 
     def status(self) -> tuple[bool, int]:
-        """(whether a run is going on, its samples so far) from STATUS."""
+        """Ask the device for its STATUS.
+
+        Returns:
+            Whether a run is going on, and the samples of the current (else last) run so far.
+        """
         reply = self._exchange(Kind.STATUS, b"", answer=Kind.ACK)
         if len(reply.body) != 7:
             raise DeviceError(f"{self.port}: a STATUS answer of {len(reply.body)} bytes")
@@ -104,7 +139,14 @@ class Link:
         return bool(running), samples
 
     def next_frame(self, timeout: float) -> Frame | None:
-        """The next device frame (TELEMETRY, DONE, ...) within `timeout` [s], else None."""
+        """The next device frame (TELEMETRY, DONE, ...) within `timeout`, else None.
+
+        Args:
+            timeout: how long to wait for one [s].
+
+        Returns:
+            The oldest device frame not yet taken; None when none came in time.
+        """
         deadline = time.monotonic() + timeout
         while not self.inbox:
             if not self._read() and time.monotonic() > deadline:

@@ -33,7 +33,15 @@ EMULATED = (Channel("i", "A"), Channel("omega", "rad/s"))  # the plant's truth: 
 
 @dataclass(frozen=True)
 class MotorGains:
-    """The device's loop settings: current PI (4.14), moving-average order (4.17), speed PI."""
+    """The device's loop settings: current PI (4.14), moving-average order (4.17), speed PI.
+
+    Attributes:
+        kp: the current loop's proportional gain K_p [V/A].
+        ki: the current loop's integral gain K_i [V/(A·s)].
+        filter_order: samples in the current reading's moving average (4.17).
+        kp_speed: the load motor's speed-loop proportional gain [V·s/rad].
+        ki_speed: the load motor's speed-loop integral gain [V/rad].
+    """
 
     kp: float = 10.0  # [V/A]
     ki: float = 100.0  # [V/(A·s)]
@@ -42,13 +50,24 @@ class MotorGains:
     ki_speed: float = 10.0  # [V/rad]
 
     def encode(self) -> bytes:
-        """SET_GAINS' body for the motor rig: five float32."""
+        """SET_GAINS' body for the motor rig.
+
+        Returns:
+            kp, ki, filter_order, kp_speed, ki_speed as five float32 (20 bytes).
+        """
         return struct.pack("<5f", self.kp, self.ki, self.filter_order, self.kp_speed,
                            self.ki_speed)  # fmt: skip
 
     @classmethod
     def decode(cls, body: bytes) -> MotorGains:
-        """SET_GAINS' body; DeviceError when it does not decode or is out of range."""
+        """SET_GAINS' body; DeviceError when it does not decode or is out of range.
+
+        Args:
+            body: the message's body: five float32 (`encode`).
+
+        Returns:
+            The gains it carries.
+        """
         if len(body) != 20:
             raise DeviceError(f"SET_GAINS for the motor rig takes 5 reals (got {len(body)} bytes)")
         kp, ki, order, kp_speed, ki_speed = struct.unpack("<5f", body)
@@ -63,7 +82,13 @@ Plant = Callable[[MotorGains, Program, float, int], np.ndarray]
 
 
 class MotorDevice(PlayedRun):
-    """The rig's program, run by the emulator against a simulated dual-motor rig."""
+    """The rig's program, run by the emulator against a simulated dual-motor rig.
+
+    Args:
+        plant: the simulated rig: (gains, reference program, duration [s], seed) -> one row
+            per control period of the MEASURED + EMULATED channels (`Plant`).
+        dt: the control period, the rig's sample period [s].
+    """
 
     def __init__(self, plant: Plant, dt: float) -> None:
         self.plant = plant
@@ -73,7 +98,12 @@ class MotorDevice(PlayedRun):
         self.reference = Program(Shape.CURRENT, (1.0, 0.0, 0.0, 5.0))
 
     def configure(self, kind: int, body: bytes) -> None:
-        """Take SET_GAINS (MotorGains) or SET_REFERENCE (a current program)."""
+        """Take SET_GAINS (MotorGains) or SET_REFERENCE (a current program).
+
+        Args:
+            kind: the command's message type.
+            body: the command's body.
+        """
         if kind == Kind.SET_GAINS:
             self.gains = MotorGains.decode(body)
         elif kind == Kind.SET_REFERENCE:
@@ -85,7 +115,12 @@ class MotorDevice(PlayedRun):
             raise DeviceError(f"the motor rig does not take {Kind(kind).name}")
 
     def start(self, duration: float, seed: int) -> None:
-        """A run of `duration` [s] from rest; the plant runs at the first sample (PlayedRun)."""
+        """A run of `duration` from rest; the plant runs at the first sample (PlayedRun).
+
+        Args:
+            duration: the run's length [s].
+            seed: the seed of the plant's sensor noise.
+        """
         if not duration > 0:
             raise DeviceError(f"the run's duration must be > 0 (got {duration:g} s)")
         self._begin(lambda: self.plant(self.gains, self.reference, duration, seed))
@@ -105,6 +140,14 @@ class MotorPins:
     loops.motor_current does); the ACS712's output is read as the 10-bit ADC's code, with the
     sensor noise drawn from the run's seed as simulate_batch draws it; the encoder's count
     is that of the shaft angle. `trace` keeps the true (i, ω) [A, rad/s] per period.
+
+    Args:
+        Ad: the rig's zero-order-hold state matrix over one control period, shape (4, 4)
+            (state θ [rad], ω [rad/s], i₁ [A], i₂ [A]; plants.motor_rig).
+        Bd: its input matrix, shape (4, 2) (inputs V₁, V₂ [V]).
+        sensor: the ACS712 current sensor and the ADC that reads it.
+        counts_per_rev: the encoder's counts per shaft revolution.
+        v_max: the H-bridges' supply voltage, the voltage at full duty [V].
     """
 
     tick_us = None  # a control period per ADC conversion
@@ -126,7 +169,11 @@ class MotorPins:
         self.start(0)
 
     def start(self, seed: int) -> None:
-        """A run from rest; sensor noise from default_rng(seed) in order."""
+        """A run from rest; sensor noise from default_rng(seed) in order.
+
+        Args:
+            seed: the run's noise seed.
+        """
         self.x = np.zeros(self.Ad.shape[0])
         self._rng = np.random.default_rng(seed)
         self._noise = np.empty(0)
@@ -134,7 +181,14 @@ class MotorPins:
         self.trace = []
 
     def period(self, pins: Pins) -> Inputs:
-        """The outputs held over the last period act; the ADC code and encoder count now."""
+        """The outputs held over the last period act; the ADC code and encoder count now.
+
+        Args:
+            pins: the firmware's outputs, held over the period just ended.
+
+        Returns:
+            The current sensor's ADC code and the encoder's count at the new period's start.
+        """
         if self._n > 0:
             volts = [self._voltage(duty, pins.porta, bit) for duty, bit in
                      zip((pins.ocr3a, pins.ocr4a), DIRECTION_BITS, strict=True)]  # fmt: skip

@@ -39,7 +39,14 @@ SCHEDULES = ("constant", "piecewise", "fuzzy")
 
 
 def encode_gains(schedule: GainSchedule) -> bytes:
-    """SET_GAINS' body: schedule u8, rows u8, then per row K_p, K_i, K_d and its point (float32)."""
+    """SET_GAINS' body: schedule u8, rows u8, then per row K_p, K_i, K_d and its point (float32).
+
+    Args:
+        schedule: the PID gains K(θ_r) of Eq. (2.4) to send.
+
+    Returns:
+        The message's body, 2 + 16 · rows bytes.
+    """
     rows = schedule.gains.shape[0]
     points = np.broadcast_to(schedule.points, (rows,))
     table = np.column_stack([schedule.gains, points])
@@ -47,7 +54,14 @@ def encode_gains(schedule: GainSchedule) -> bytes:
 
 
 def decode_gains(body: bytes) -> GainSchedule:
-    """SET_GAINS' body as a GainSchedule; DeviceError when it does not decode."""
+    """SET_GAINS' body as a GainSchedule; DeviceError when it does not decode.
+
+    Args:
+        body: the message's body (`encode_gains`).
+
+    Returns:
+        The gain schedule it carries.
+    """
     if len(body) < 2 or body[0] >= len(SCHEDULES) or len(body) != 2 + 16 * body[1]:
         raise DeviceError("SET_GAINS does not decode")
     table = unpack_floats(body, 4 * body[1], 2).reshape(body[1], 4)
@@ -58,7 +72,11 @@ def decode_gains(body: bytes) -> GainSchedule:
 
 
 class PneuNetDevice:
-    """The rig's program, run by the emulator against the simulated actuator."""
+    """The rig's program, run by the emulator against the simulated actuator.
+
+    Args:
+        params: the simulated PneuNet and its flex sensor; None: the defaults.
+    """
 
     def __init__(self, params: PneuNetParams | None = None) -> None:
         self.params = params or PneuNetParams()
@@ -70,7 +88,12 @@ class PneuNetDevice:
         self._steps = 0
 
     def configure(self, kind: int, body: bytes) -> None:
-        """Take SET_GAINS, SET_REFERENCE or SET_OUTPUT (channel 0: the PWM count)."""
+        """Take SET_GAINS, SET_REFERENCE or SET_OUTPUT (channel 0: the PWM count).
+
+        Args:
+            kind: the command's message type.
+            body: the command's body.
+        """
         if kind == Kind.SET_GAINS:
             self.schedule = decode_gains(body)
         elif kind == Kind.SET_REFERENCE:
@@ -84,8 +107,13 @@ class PneuNetDevice:
             raise DeviceError(f"the PneuNet rig does not take {Kind(kind).name}")
 
     def start(self, duration: float, seed: int) -> None:
-        """A run of `duration` [s] from rest; sensor noise from seed as run_closed_loop draws
-        it (the first of SeedSequence(seed)'s two streams)."""
+        """A run of `duration` from rest; sensor noise from seed as run_closed_loop draws
+        it (the first of SeedSequence(seed)'s two streams).
+
+        Args:
+            duration: the run's length [s].
+            seed: the run's noise seed.
+        """
         self._steps = round(duration / self.params.pwm_period)
         noise_seed, _ = np.random.SeedSequence(seed).spawn(2)
         self._noise = np.random.default_rng(noise_seed).standard_normal(self._steps)
@@ -95,7 +123,12 @@ class PneuNetDevice:
         self._n = 0
 
     def sample(self) -> np.ndarray | None:
-        """One PWM period: (reference, angle, PWM count); None when the run is over."""
+        """One PWM period: (reference, angle, PWM count); None when the run is over.
+
+        Returns:
+            (reference [deg], measured angle [deg], PWM count), shape (3,); None when the run
+            is over.
+        """
         if self._n >= self._steps:
             return None
         t = self._n * self.params.pwm_period
@@ -117,7 +150,14 @@ class PneuNetDevice:
 
 class PneuNetRig:
     """The tuner's view of a PneuNet rig: run one experiment with gains K over the line and
-    return its response, as loops.pneunet_pid.SimulatedRig does in process."""
+    return its response, as loops.pneunet_pid.SimulatedRig does in process.
+
+    Args:
+        link: the line to a PneuNet rig.
+        program: the reference program of every experiment.
+        duration: each experiment's length [s].
+        seed: the noise seed of the first experiment (the n-th takes seed + n).
+    """
 
     def __init__(self, link: Link, program: Program, duration: float, seed: int) -> None:
         if link.info.rig != RigKind.PNEUNET:
@@ -126,7 +166,14 @@ class PneuNetRig:
         self.calls = 0
 
     def __call__(self, gains: np.ndarray) -> Response:
-        """One experiment from rest with constant gains [K_p, K_i, K_d]."""
+        """One experiment from rest with constant gains [K_p, K_i, K_d].
+
+        Args:
+            gains: [K_p, K_i, K_d], shape (3,) (per degree, as chapter 2's gains).
+
+        Returns:
+            The sample times [s], reference [deg] and measured angle [deg] of the run.
+        """
         schedule = GainSchedule("constant", np.asarray(gains, dtype=float)[None, :])
         self.link.command(Kind.SET_GAINS, encode_gains(schedule))
         self.link.command(Kind.SET_REFERENCE, self.program.encode())
@@ -146,7 +193,11 @@ class PneuNetPins:
     """The PneuNet's plant behind the firmware's pins (rigs/firmware.py): each PWM period the
     valve's duty (OCR1A of Timer1's period, the pump on) drives the actuator model, and the
     flex sensor is read as the 10-bit ADC's code, its noise drawn from the run's seed as
-    PneuNetDevice draws it."""
+    PneuNetDevice draws it.
+
+    Args:
+        params: the simulated PneuNet; None: the defaults (the ones the firmware is built for).
+    """
 
     tick_us = None  # a PWM period per ADC conversion
 
@@ -161,14 +212,25 @@ class PneuNetPins:
         self.start(0)
 
     def start(self, seed: int) -> None:
-        """A run from rest; the sensor's noise from the first of SeedSequence(seed)'s streams."""
+        """A run from rest; the sensor's noise from the first of SeedSequence(seed)'s streams.
+
+        Args:
+            seed: the run's noise seed.
+        """
         noise_seed, _ = np.random.SeedSequence(seed).spawn(2)
         self._rng = np.random.default_rng(noise_seed)
         self._plant = PneuNetBatch(self.params, 1, None)
         self._n = 0
 
     def period(self, pins: Pins) -> Inputs:
-        """The last period's duty acts; the flex sensor's ADC code now."""
+        """The last period's duty acts; the flex sensor's ADC code now.
+
+        Args:
+            pins: the firmware's outputs, held over the period just ended (OCR1A, the pump).
+
+        Returns:
+            The flex sensor's ADC code at the new period's start.
+        """
         if self._n > 0:
             pump = pins.porth >> PUMP_BIT & 1
             self._plant.advance(np.array([pump * min(pins.ocr1a, VALVE_TICKS) / VALVE_TICKS]))

@@ -37,7 +37,12 @@ MAX_VALUES = (MAX_FRAME - 3 - 2 - 2) // 4  # header, CRC, shape and count bytes
 
 @dataclass(frozen=True)
 class Program:
-    """A reference program: its shape and numbers (module docstring)."""
+    """A reference program: its shape and numbers (module docstring).
+
+    Attributes:
+        shape: the kind of program.
+        values: its numbers, as the shape takes them (module docstring).
+    """
 
     shape: Shape
     values: tuple[float, ...]
@@ -55,7 +60,14 @@ class Program:
             raise ConfigError("program", "numbers must be finite")
 
     def at(self, t: np.ndarray | float) -> np.ndarray:
-        """The reference at times t [s]."""
+        """The reference at times t [s].
+
+        Args:
+            t: times since the run's start [s], a scalar or any shape.
+
+        Returns:
+            The reference at each time, t's shape (the unit of the program's levels).
+        """
         t = np.asarray(t, dtype=float)
         v = self.values
         if self.shape == Shape.ACTUATION:
@@ -72,12 +84,23 @@ class Program:
         return levels[np.clip(index, 0, levels.size - 1)]
 
     def encode(self) -> bytes:
-        """The body of SET_REFERENCE: shape u8, count u8, the numbers as float32."""
+        """The body of SET_REFERENCE: shape u8, count u8, the numbers as float32.
+
+        Returns:
+            The message's body, 2 + 4 · count bytes.
+        """
         return struct.pack("<BB", self.shape, len(self.values)) + pack_floats(self.values)
 
     @classmethod
     def decode(cls, body: bytes) -> Program:
-        """A SET_REFERENCE body as a Program; DeviceError when it does not decode."""
+        """A SET_REFERENCE body as a Program; DeviceError when it does not decode.
+
+        Args:
+            body: the message's body (`encode`).
+
+        Returns:
+            The program it carries.
+        """
         if len(body) < 2:
             raise DeviceError("SET_REFERENCE without its shape and count")
         shape, count = struct.unpack_from("<BB", body)
@@ -90,5 +113,13 @@ class Program:
 
 
 def steps(levels: list[float] | tuple[float, ...], hold: float) -> Program:
-    """Levels held `hold` [s] each, in order."""
+    """Levels held `hold` each, in order (the last one to the end of the run).
+
+    Args:
+        levels: the reference's levels, in the unit of the rig's reference.
+        hold: how long each level is held [s].
+
+    Returns:
+        A steps program.
+    """
     return Program(Shape.STEPS, (float(hold), *map(float, levels)))

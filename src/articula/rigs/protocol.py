@@ -62,7 +62,13 @@ class RigKind(IntEnum):
 
 @dataclass(frozen=True)
 class Frame:
-    """One decoded message: its type, the sender's sequence number and its body."""
+    """One decoded message: its type, the sender's sequence number and its body.
+
+    Attributes:
+        kind: the message type (a `Kind` value, or an unknown type as received).
+        seq: the sender's sequence number (u16, wrapping).
+        body: the message's fields (docs/protocol.md), without header and CRC.
+    """
 
     kind: int
     seq: int
@@ -71,7 +77,12 @@ class Frame:
 
 @dataclass(frozen=True)
 class Channel:
-    """A telemetry channel: name and unit (SI or counts)."""
+    """A telemetry channel: name and unit (SI or counts).
+
+    Attributes:
+        name: the channel's name (ASCII), e.g. "angle".
+        unit: its unit (ASCII), e.g. "deg", "A", "counts".
+    """
 
     name: str
     unit: str
@@ -79,7 +90,15 @@ class Channel:
 
 @dataclass(frozen=True)
 class Info:
-    """The handshake: what is on the other end of the line."""
+    """The handshake: what is on the other end of the line.
+
+    Attributes:
+        rig: which of the three rigs it is.
+        protocol: the protocol version the device speaks.
+        firmware: the firmware's version (major, minor, patch).
+        sample_period_us: the device's sample period [µs].
+        channels: the telemetry channels, in the order of TELEMETRY's values.
+    """
 
     rig: RigKind
     protocol: int
@@ -90,12 +109,27 @@ class Info:
 
 def crc16(data: bytes) -> int:
     """CRC-16/CCITT-FALSE (polynomial 0x1021, initial 0xFFFF): 0x29B1 for b"123456789".
-    binascii's CRC-CCITT is this CRC with the initial value given, computed in C."""
+
+    binascii's CRC-CCITT is this CRC with the initial value given, computed in C.
+
+    Args:
+        data: the bytes to check (a frame's header and body).
+
+    Returns:
+        The CRC, 0-65535.
+    """
     return binascii.crc_hqx(data, 0xFFFF)
 
 
 def cobs_encode(data: bytes) -> bytes:
-    """Consistent Overhead Byte Stuffing of `data` (at most 254 bytes: one block)."""
+    """Consistent Overhead Byte Stuffing of `data` (at most 254 bytes: one block).
+
+    Args:
+        data: the bytes to stuff, at most 254.
+
+    Returns:
+        The stuffed bytes, one longer and without a zero (no delimiter).
+    """
     out = bytearray([0])
     code_at, code = 0, 1
     for byte in data:
@@ -111,7 +145,14 @@ def cobs_encode(data: bytes) -> bytes:
 
 
 def cobs_decode(data: bytes) -> bytes:
-    """The bytes `cobs_encode` was given; DeviceError for a malformed block."""
+    """The bytes `cobs_encode` was given; DeviceError for a malformed block.
+
+    Args:
+        data: a COBS block, without its delimiter.
+
+    Returns:
+        The unstuffed bytes.
+    """
     out = bytearray()
     i = 0
     while i < len(data):
@@ -126,7 +167,16 @@ def cobs_decode(data: bytes) -> bytes:
 
 
 def encode(kind: int, seq: int, body: bytes = b"") -> bytes:
-    """The wire bytes of one message, delimiter included."""
+    """The wire bytes of one message, delimiter included; DeviceError when it is too long.
+
+    Args:
+        kind: the message type.
+        seq: the sender's sequence number (taken modulo 65536).
+        body: the message's fields.
+
+    Returns:
+        COBS(type | seq | body | CRC) followed by the zero delimiter.
+    """
     payload = HEADER.pack(kind, seq & 0xFFFF) + body
     payload += CRC.pack(crc16(payload))
     if len(payload) > MAX_FRAME:
@@ -135,7 +185,14 @@ def encode(kind: int, seq: int, body: bytes = b"") -> bytes:
 
 
 def decode(frame: bytes) -> Frame:
-    """One message from the bytes between two delimiters; DeviceError when it is damaged."""
+    """One message from the bytes between two delimiters; DeviceError when it is damaged.
+
+    Args:
+        frame: the COBS-stuffed bytes between two delimiters.
+
+    Returns:
+        The decoded message, its CRC checked.
+    """
     payload = cobs_decode(frame)
     if len(payload) < HEADER.size + CRC.size:
         raise DeviceError(f"a frame of {len(payload)} bytes is too short")
@@ -153,7 +210,14 @@ class Deframer:
         self._pending = bytearray()
 
     def feed(self, data: bytes) -> list[bytes]:
-        """The complete frames (delimiters removed, empty ones skipped) that `data` ends."""
+        """The complete frames (delimiters removed, empty ones skipped) that `data` ends.
+
+        Args:
+            data: the bytes just read from the line.
+
+        Returns:
+            The frames completed, still COBS-stuffed (for `decode`), in order.
+        """
         self._pending += data
         *frames, rest = bytes(self._pending).split(b"\0")
         self._pending = bytearray(rest[-2 * MAX_FRAME :])  # garbage cannot grow without bound
@@ -161,19 +225,42 @@ class Deframer:
 
 
 def pack_floats(values: np.ndarray | list[float]) -> bytes:
-    """Values as little-endian float32."""
+    """Values as little-endian float32.
+
+    Args:
+        values: the numbers to pack, shape (n,).
+
+    Returns:
+        4 · n bytes.
+    """
     return np.asarray(values, dtype="<f4").tobytes()
 
 
 def unpack_floats(body: bytes, count: int, offset: int = 0) -> np.ndarray:
-    """`count` little-endian float32 from body[offset:] as float64; DeviceError if short."""
+    """`count` little-endian float32 from body[offset:] as float64; DeviceError if short.
+
+    Args:
+        body: a message's body.
+        count: how many float32 to read.
+        offset: where the first one starts in `body` [bytes].
+
+    Returns:
+        The values, shape (count,).
+    """
     if len(body) < offset + 4 * count:
         raise DeviceError(f"expected {count} reals, the body holds {(len(body) - offset) // 4}")
     return np.frombuffer(body, dtype="<f4", count=count, offset=offset).astype(float)
 
 
 def encode_info(info: Info) -> bytes:
-    """The body of INFO."""
+    """The body of INFO.
+
+    Args:
+        info: the handshake to send.
+
+    Returns:
+        The message's body (docs/protocol.md).
+    """
     out = struct.pack("<BBBBBIB", info.protocol, info.rig, *info.firmware,
                       info.sample_period_us, len(info.channels))  # fmt: skip
     for channel in info.channels:
@@ -184,7 +271,14 @@ def encode_info(info: Info) -> bytes:
 
 
 def decode_info(body: bytes) -> Info:
-    """INFO's body as an Info; DeviceError when it does not decode."""
+    """INFO's body as an Info; DeviceError when it does not decode.
+
+    Args:
+        body: the message's body (`encode_info`).
+
+    Returns:
+        The handshake it carries.
+    """
     try:
         protocol, rig, major, minor, patch, period, count = struct.unpack_from("<BBBBBIB", body)
         at, channels = struct.calcsize("<BBBBBIB"), []

@@ -26,7 +26,13 @@ FLUSH_S = 0.1  # [s] between flushes of the journal to the disk
 
 
 class Recorder:
-    """Telemetry rows (device time [s], then one value per channel) into `folder`."""
+    """Telemetry rows (device time [s], then one value per channel) into `folder`.
+
+    Args:
+        folder: the run folder to write (created now, its journal opened).
+        config: the run's configuration, written as its config.toml.
+        channels: the telemetry channels' names, one per value of a row.
+    """
 
     def __init__(self, folder: Path, config: Mapping[str, Any], channels: Sequence[str]) -> None:
         make_folder(folder)
@@ -39,7 +45,12 @@ class Recorder:
         self._started = time.monotonic()
 
     def add(self, t: float, row: np.ndarray) -> None:
-        """One sample: device time t [s] and its channel values."""
+        """One sample: device time t [s] and its channel values.
+
+        Args:
+            t: the sample's device time since the run's start [s].
+            row: one value per channel, shape (channels,).
+        """
         self.t.append(t)
         self.rows.append(np.asarray(row, dtype=float))
         self._journal.write(",".join(f"{v:.9g}" for v in (t, *row)) + "\n")
@@ -48,14 +59,26 @@ class Recorder:
             self._flushed = time.monotonic()
 
     def columns(self) -> dict[str, np.ndarray]:
-        """The samples so far as trace columns (t and one per channel)."""
+        """The samples so far as trace columns (t and one per channel).
+
+        Returns:
+            Column name -> values, shape (samples,): "t" [s], then each channel in its unit.
+        """
         values = np.array(self.rows).reshape(-1, len(self.channels))
         return {"t": np.array(self.t), **dict(zip(self.channels, values.T, strict=True))}
 
     def capture(self, run: Callable[[], Mapping[str, float]], stats: LinkStats) -> dict[str, Any]:
         """Do `run` (which feeds `add` and returns the metrics) and write the run folder;
         whatever stops it, what was received is written, marked incomplete, and the error
-        goes on. Returns the record."""
+        goes on.
+
+        Args:
+            run: the run on the rig: feeds `add` with each sample, returns the run's metrics.
+            stats: the link's loss counters, recorded with the run.
+
+        Returns:
+            The run's record (record.json).
+        """
         try:
             metrics = run()
         except BaseException as exc:
@@ -67,8 +90,16 @@ class Recorder:
     def finish(
         self, metrics: Mapping[str, float], stats: LinkStats, incomplete: str | None = None
     ) -> dict[str, Any]:
-        """Write the run folder from the samples received; returns the record. `incomplete`
-        says why a run ended early (its metrics are those of what was received)."""
+        """Write the run folder from the samples received.
+
+        Args:
+            metrics: the run's metrics (those of what was received when it ended early).
+            stats: the link's loss counters, recorded under "link".
+            incomplete: why the run ended early; None for a complete run.
+
+        Returns:
+            The run's record (record.json).
+        """
         self._journal.close()
         record = build_record(self.config, Result(dict(metrics), {}),
                               time.monotonic() - self._started)  # fmt: skip

@@ -19,10 +19,21 @@ def run_program(
     seed: int,
     on_sample: Callable[[float, np.ndarray], None] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Run the rig's loaded program for `duration` [s] (noise seed for an emulated rig);
-    returns the sample times [s, device clock from the run's start] and the telemetry rows
-    (one per sample received, one column per channel of the handshake). `on_sample(t, row)`
-    sees each sample as it arrives (a Recorder's add)."""
+    """Run the rig's loaded program for `duration` and take its telemetry until DONE.
+
+    Args:
+        link: the line to the rig, its program loaded.
+        duration: the run's length [s].
+        seed: the noise seed (an emulated rig draws its sensor noise from it; a real one
+            ignores it).
+        on_sample: called as on_sample(t, row) with each sample as it arrives (a Recorder's
+            add); None: nothing.
+
+    Returns:
+        The sample times [s, device clock from the run's start], shape (n,), and the
+        telemetry rows, shape (n, channels) (one per sample received, one column per
+        channel of the handshake).
+    """
     channels = len(link.info.channels)
     link.command(Kind.STREAM, struct.pack("<H", 1))
     start = link.command(Kind.START, struct.pack("<fI", duration, seed & 0xFFFFFFFF), fresh=True)

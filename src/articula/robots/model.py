@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import xml.etree.ElementTree as ET
 from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 from importlib import resources
@@ -13,22 +12,32 @@ import pinocchio as pin
 
 from articula.errors import ConfigError, ModelError
 from articula.geometry.shapes import ConvexShape
-from articula.limits import MAX_ANGLE, MAX_LENGTH, MAX_LINKS
+from articula.limits import MAX_ANGLE, MAX_LINKS
 from articula.native import captured_output
 from articula.robots.urdf_geometry import collision_shapes
-
-# Limits [rad] given to a continuous joint, read as a revolute one so that it keeps one
-# configuration entry (Pinocchio's unbounded joints use two, cos and sin). ±2π lets the joint
-# reach every orientation from either side and turn a full circle each way from 0, while BAORNN's
-# samples within the limits stay meaningful (±MAX_ANGLE would spread them over 300 turns).
-CONTINUOUS_LIMIT = 2 * np.pi
+from articula.robots.urdf_kinematics import (
+    _add_tool_frame,
+    _check_magnitudes,
+    _check_serial,
+    _check_size,
+    _lock,
+    _prepare_urdf,
+    _unbounded,
+)
 
 BUILTIN = {"iiwa14": ("iiwa14/iiwa14.urdf", "iiwa_link_ee")}
 
 
 @dataclass(frozen=True, eq=False)
 class LinkGeometry:
-    """A link's collision shapes and their poses in the link frame."""
+    """A link's collision shapes and their poses in the link frame.
+
+    Attributes:
+        name: the link's name in the URDF.
+        frame_id: index of the link's body frame in the Pinocchio model.
+        shapes: the link's convex collision shapes.
+        placements: pose of each shape in the link frame, each shape (4, 4) [m].
+    """
 
     name: str
     frame_id: int
@@ -41,6 +50,11 @@ class RobotModel:
 
     Mimic joints (URDF <mimic>) have no configuration entry of their own: they follow the
     joint they mimic, q_mimic = multiplier · q_joint + offset, in every kinematic quantity.
+
+    Args:
+        model: the Pinocchio kinematic model.
+        links: the collision shapes of the links, in frame order.
+        ee_frame: name of the end-effector frame.
     """
 
     def __init__(self, model: pin.Model, links: Sequence[LinkGeometry], ee_frame: str) -> None:
@@ -83,6 +97,9 @@ class RobotModel:
                 geometry.meshes.cache_folder) instead of one hull per separate part: True for
                 every link, or link names; a non-convex link then keeps its concavities
                 (tighter clearance) at the cost of a decomposition on first load.
+
+        Returns:
+            The robot model.
         """
         urdf = Path(path)
         if not urdf.is_file():
@@ -136,6 +153,9 @@ class RobotModel:
             locked_joints: joint name -> fixed value [rad or m] (see `from_urdf`).
             ee_offset: pose (4×4) of the tool point in the end-effector frame [m].
             decompose: link meshes to decompose with CoACD (see `from_urdf`).
+
+        Returns:
+            The robot model.
         """
         if name not in BUILTIN:
             raise ConfigError("builtin", f"unknown robot {name!r}; choose one of {sorted(BUILTIN)}")
@@ -179,12 +199,27 @@ class RobotModel:
         return self.model.velocityLimit.copy()
 
     def clip(self, q: np.ndarray) -> np.ndarray:
-        """q clipped into the joint limits (the projection of Eq. 1.17)."""
+        """q clipped into the joint limits (the projection of Eq. 1.17).
+
+        Args:
+            q: joint positions, shape (nq,) [rad or m].
+
+        Returns:
+            The clipped joint positions, shape (nq,) [rad or m].
+        """
         return np.minimum(np.maximum(q, self.model.lowerPositionLimit),
                           self.model.upperPositionLimit)  # fmt: skip
 
     def check_q(self, q: Sequence[float] | np.ndarray, field: str = "q") -> np.ndarray:
-        """q as a float array of length nq, or ConfigError naming the problem."""
+        """q as a float array of length nq, or ConfigError naming the problem.
+
+        Args:
+            q: joint positions, nq values [rad or m].
+            field: the name the error reports the problem on.
+
+        Returns:
+            The joint positions, shape (nq,) [rad or m] (q itself if already such an array).
+        """
         if type(q) is np.ndarray and q.dtype == np.float64 and q.shape == (self.nq,):
             arr = q  # the planner's hot path: no copy
         else:
@@ -199,20 +234,45 @@ class RobotModel:
         return arr
 
     def forward(self, q: np.ndarray) -> None:
-        """Update every frame placement for configuration q (unchecked, for hot loops)."""
+        """Update every frame placement for configuration q (unchecked, for hot loops).
+
+        Args:
+            q: joint positions, shape (nq,) [rad or m].
+        """
         pin.framesForwardKinematics(self.model, self.data, q)
 
     def ee_pose(self, q: Sequence[float] | np.ndarray) -> np.ndarray:
-        """Pose of the end-effector frame in the world (4×4)."""
+        """Pose of the end-effector frame in the world (4×4).
+
+        Args:
+            q: joint positions, nq values [rad or m].
+
+        Returns:
+            The end-effector pose, shape (4, 4) [m].
+        """
         self.forward(self.check_q(q))
         return self.data.oMf[self.ee_frame_id].homogeneous.copy()
 
     def ee_position(self, q: Sequence[float] | np.ndarray) -> np.ndarray:
-        """Position [m] of the end-effector frame in the world."""
+        """Position [m] of the end-effector frame in the world.
+
+        Args:
+            q: joint positions, nq values [rad or m].
+
+        Returns:
+            The end-effector position, shape (3,) [m].
+        """
         return self.ee_pose(q)[:3, 3]
 
     def link_poses(self, q: Sequence[float] | np.ndarray) -> dict[str, np.ndarray]:
-        """Pose (4×4, world) of every body frame, by link name."""
+        """Pose (4×4, world) of every body frame, by link name.
+
+        Args:
+            q: joint positions, nq values [rad or m].
+
+        Returns:
+            Each link's pose in the world, shape (4, 4) [m], by link name.
+        """
         self.forward(self.check_q(q))
         return {
             f.name: self.data.oMf[i].homogeneous.copy()
@@ -221,7 +281,15 @@ class RobotModel:
         }
 
     def jacobian(self, q: Sequence[float] | np.ndarray) -> np.ndarray:
-        """6×nq Jacobian of the end-effector: rows vx, vy, vz, wx, wy, wz in world axes."""
+        """6×nq Jacobian of the end-effector: rows vx, vy, vz, wx, wy, wz in world axes.
+
+        Args:
+            q: joint positions, nq values [rad or m].
+
+        Returns:
+            The Jacobian, shape (6, nq): linear rows [m/rad], angular rows [rad/rad] (per m
+            for a prismatic joint).
+        """
         arr = self.check_q(q)
         return pin.computeFrameJacobian(
             self.model, self.data, arr, self.ee_frame_id, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
@@ -235,6 +303,15 @@ class RobotModel:
         is computed once.
 
         n·v_p = n·v_o + ω·((p − o) × n) at the parent joint's origin o, in world axes.
+
+        Args:
+            q: joint positions, shape (nq,) [rad or m] (unchecked).
+            frame_ids: the frame each point moves with, k indices into the model's frames.
+            points: the points in the world, shape (k, 3) [m].
+            directions: the directions n_k in world axes, shape (k, 3) (unit vectors).
+
+        Returns:
+            The rows n_k·J_k, shape (k, nq) [m/rad] (dimensionless for a prismatic joint).
         """
         pin.computeJointJacobians(self.model, self.data, q)
         joints = [self.model.frames[f].parentJoint for f in frame_ids]
@@ -248,138 +325,3 @@ class RobotModel:
         return np.einsum("ki,kin->kn", directions, J[:, :3]) + np.einsum(
             "ki,kin->kn", lever, J[:, 3:]
         )
-
-
-def _check_size(urdf: Path, max_links: int) -> None:
-    """ModelError for a URDF with more than `max_links` links, before Pinocchio reads it."""
-    try:
-        links = sum(1 for _, element in ET.iterparse(urdf) if element.tag == "link")
-    except (ET.ParseError, OSError) as exc:
-        raise ModelError(f"{urdf}: cannot read URDF ({exc})") from None
-    if links > max_links:
-        raise ConfigError(
-            "urdf",
-            f"{urdf} has {links} links, more than the limit of {max_links}; raise it with "
-            f"max_links = {links} in [robot]",
-        )
-
-
-def _check_magnitudes(model: pin.Model, urdf: Path) -> None:
-    """ModelError for joint origins or limits no arm has (NaN, inf, beyond the stated limits)."""
-    for name, placement in zip(model.names[1:], model.jointPlacements[1:], strict=True):
-        if not np.all(np.abs(placement.translation) <= MAX_LENGTH):
-            raise ModelError(f"{urdf}: joint {name!r} has its origin beyond ±{MAX_LENGTH:g} m")
-    limits = np.concatenate([model.lowerPositionLimit, model.upperPositionLimit])
-    if not np.all(np.abs(limits) <= MAX_ANGLE):
-        raise ModelError(f"{urdf}: joint limits must be finite and within ±{MAX_ANGLE:g}")
-
-
-def _check_serial(model: pin.Model, urdf: Path) -> None:
-    """Only 1-DoF joints (revolute, prismatic) are supported, one per configuration entry, and
-    mimic joints that follow one of them."""
-    for joint, name in zip(model.joints[1:], model.names[1:], strict=True):
-        if joint.shortname() == "JointModelMimic":
-            continue
-        if joint.nq != 1 or joint.nv != 1:
-            raise ModelError(
-                f"{urdf}: joint {name!r} ({joint.shortname()}) is not a 1-DoF revolute, "
-                "continuous or prismatic joint"
-            )
-
-
-def _prepare_urdf(urdf: Path) -> tuple[str, list[tuple[str, str]], dict[str, str]]:
-    """(URDF text with every continuous joint made revolute within ±CONTINUOUS_LIMIT, the
-    (joint, "velocity" | "effort") limits it lacked, mimic joint -> the joint it follows)."""
-    try:
-        root = ET.parse(urdf).getroot()
-    except (ET.ParseError, OSError) as exc:
-        raise ModelError(f"{urdf}: cannot read URDF ({exc})") from None
-    unlimited = []
-    mimics = {}
-    for joint in root.iter("joint"):
-        mimic = joint.find("mimic")
-        if mimic is not None:
-            mimics[joint.get("name", "")] = mimic.get("joint", "")
-        if joint.get("type") != "continuous":
-            continue
-        joint.set("type", "revolute")
-        limit = joint.find("limit")
-        if limit is None:
-            limit = ET.SubElement(joint, "limit")
-        limit.set("lower", repr(-CONTINUOUS_LIMIT))
-        limit.set("upper", repr(CONTINUOUS_LIMIT))
-        for key in ("velocity", "effort"):
-            if limit.get(key) is None:
-                # urdfdom needs both for a revolute joint; _unbounded restores a missing one
-                # as ∞, what Pinocchio gives a continuous joint without it.
-                unlimited.append((joint.get("name", ""), key))
-                limit.set(key, "0")
-    return ET.tostring(root, encoding="unicode"), unlimited, mimics
-
-
-def _unbounded(model: pin.Model, missing: Sequence[tuple[str, str]]) -> None:
-    """Set the named (joint, "velocity" | "effort") limits to ∞ (the URDF gave none)."""
-    limits = {"velocity": model.velocityLimit.copy(), "effort": model.effortLimit.copy()}
-    for name, key in missing:
-        limits[key][model.joints[model.getJointId(name)].idx_v] = np.inf
-    model.velocityLimit, model.effortLimit = limits["velocity"], limits["effort"]
-
-
-def _lock(model: pin.Model, values: dict[str, float], mimics: Mapping[str, str]) -> pin.Model:
-    """The reduced model with the named joints fixed at their values [rad or m]; the other
-    joints' reference is neutral (it does not matter: their frames keep their placements)."""
-    q_reference = pin.neutral(model)
-    ids = []
-    for name, value in values.items():
-        field = f"locked_joints.{name}"
-        if not model.existJointName(name):
-            free = [n for n, j in zip(model.names[1:], model.joints[1:], strict=True) if j.nq]
-            raise ConfigError(field, f"no joint {name!r}; the joints are {free}")
-        if name in mimics:
-            raise ConfigError(
-                field, f"{name!r} mimics {mimics[name]!r}; lock {mimics[name]!r} instead"
-            )
-        joint_id = model.getJointId(name)
-        index = model.joints[joint_id].idx_q
-        low, high = model.lowerPositionLimit[index], model.upperPositionLimit[index]
-        if not low <= value <= high:
-            raise ConfigError(field, f"{value!r} is outside the joint's limits [{low:g}, {high:g}]")
-        q_reference[index] = value
-        ids.append(joint_id)
-        # A mimic joint of a locked joint is locked with it, at the value it follows.
-        ids += [model.getJointId(m) for m, followed in mimics.items() if followed == name]
-    if len(ids) - sum(1 for j in ids if model.joints[j].nq == 0) >= model.nq:
-        raise ConfigError("locked_joints", "locks every joint; leave at least one free")
-    return pin.buildReducedModel(model, sorted(set(ids)), q_reference)
-
-
-def _add_tool_frame(model: pin.Model, ee_frame: str, offset: np.ndarray) -> str:
-    """Add the frame at pose `offset` (4×4, [m]) in frame `ee_frame` and return its name."""
-    T = np.asarray(offset, dtype=float)
-    if T.shape != (4, 4):
-        raise ConfigError("ee_offset", f"needs a 4×4 pose (got shape {T.shape})")
-    R, p = T[:3, :3], T[:3, 3]
-    if not (
-        np.all(np.abs(p) <= MAX_LENGTH)
-        and np.allclose(R @ R.T, np.eye(3), atol=1e-9)
-        and np.linalg.det(R) > 0
-        and np.array_equal(T[3], [0.0, 0.0, 0.0, 1.0])
-    ):
-        raise ConfigError(
-            "ee_offset",
-            f"needs a rigid pose: a rotation and a translation within ±{MAX_LENGTH:g} m "
-            f"(got {T.tolist()})",
-        )
-    if not model.existFrame(ee_frame):
-        names = [f.name for f in model.frames if f.type == pin.FrameType.BODY]
-        raise ConfigError("ee_frame", f"no frame {ee_frame!r}; the links are {names}")
-    name = f"{ee_frame}_offset"
-    if model.existFrame(name):
-        raise ConfigError("ee_offset", f"the URDF already has a frame {name!r}")
-    parent_id = model.getFrameId(ee_frame)
-    parent = model.frames[parent_id]
-    placement = parent.placement * pin.SE3(R.copy(), p.copy())
-    model.addFrame(
-        pin.Frame(name, parent.parentJoint, parent_id, placement, pin.FrameType.OP_FRAME)
-    )
-    return name

@@ -30,6 +30,10 @@ def collision_shapes(
             see geometry.meshes.convex_parts) instead of one hull per separate part: True for
             every link, False for none, or link names (ConfigError "decompose" for a name the
             URDF has no link of).
+
+    Returns:
+        Each link's (convex shape, pose of the shape in the link frame, shape (4, 4) [m])
+        pairs, by link name; links without <collision> are left out.
     """
     try:
         root = ET.parse(urdf).getroot()
@@ -66,7 +70,16 @@ def _decomposed_links(decompose: bool | Collection[str], names: Sequence[str]) -
 
 
 def resolve_mesh_path(filename: str, urdf: Path, package_dirs: Sequence[Path]) -> Path:
-    """File path of a URDF mesh reference: package://, file:// or relative to the URDF."""
+    """File path of a URDF mesh reference: package://, file:// or relative to the URDF.
+
+    Args:
+        filename: the `filename` attribute of a <mesh> element.
+        urdf: the URDF file that names the mesh.
+        package_dirs: folders that hold the packages a package:// reference names.
+
+    Returns:
+        The mesh file's path (a package:// file is checked to exist; others are not).
+    """
     if filename.startswith("package://"):
         package, _, rest = filename.removeprefix("package://").partition("/")
         candidates = [Path(d) / package / rest for d in package_dirs]
@@ -126,7 +139,15 @@ def _shapes(
 def mesh_parts(mesh: trimesh.Trimesh, name: str) -> list[ConvexShape]:
     """One convex hull per separate part of a link mesh (a V-HACD file holds its convex
     pieces as separate parts; one hull over them all would fill the gaps between them), or
-    the hull of the whole mesh when it is one part, has too many, or a part has no volume."""
+    the hull of the whole mesh when it is one part, has too many, or a part has no volume.
+
+    Args:
+        mesh: the link's triangle mesh [m].
+        name: what the mesh is (its file), for error messages and the parts' names.
+
+    Returns:
+        The convex hulls, in the mesh's frame.
+    """
     # No repair: hulls need only the vertices, and trimesh's hole filling needs networkx.
     pieces = mesh.split(only_watertight=False, repair=False)
     if 1 < len(pieces) <= MAX_LINK_PARTS:
@@ -138,7 +159,15 @@ def mesh_parts(mesh: trimesh.Trimesh, name: str) -> list[ConvexShape]:
 
 
 def origin(element: ET.Element | None, where: str) -> np.ndarray:
-    """The pose (4×4) an <origin> element gives (identity without one)."""
+    """The pose (4×4) an <origin> element gives (identity without one).
+
+    Args:
+        element: the <origin> element (its xyz [m] and rpy [rad]), or None.
+        where: the element's place in the URDF, for the error messages.
+
+    Returns:
+        The pose, shape (4, 4) [m].
+    """
     if element is None:
         return np.eye(4)
     return pose(
@@ -148,7 +177,16 @@ def origin(element: ET.Element | None, where: str) -> np.ndarray:
 
 
 def floats(text: str, count: int, where: str) -> tuple[float, ...]:
-    """`count` numbers from a URDF attribute; ModelError naming `where` otherwise."""
+    """`count` numbers from a URDF attribute; ModelError naming `where` otherwise.
+
+    Args:
+        text: the attribute's value, numbers separated by spaces.
+        count: how many numbers it must hold.
+        where: the attribute's place in the URDF, for the error messages.
+
+    Returns:
+        The numbers.
+    """
     try:
         values = tuple(float(v) for v in text.split())
     except ValueError:

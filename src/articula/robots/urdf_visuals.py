@@ -19,7 +19,13 @@ from articula.robots.urdf_geometry import floats, origin, resolve_mesh_path
 @dataclass(frozen=True)
 class Visual:
     """One <visual> of a link: its mesh [m], pose in the link frame (4×4) and colour (RGBA in
-    0-1, None when the URDF gives none)."""
+    0-1, None when the URDF gives none).
+
+    Attributes:
+        mesh: the visual's triangle mesh, in its own frame [m].
+        placement: pose of the mesh in the link frame, shape (4, 4) [m].
+        rgba: colour as red, green, blue, alpha in 0-1, or None when the URDF gives none.
+    """
 
     mesh: trimesh.Trimesh
     placement: np.ndarray
@@ -31,6 +37,13 @@ def visual_meshes(urdf: Path, package_dirs: Sequence[Path] = ()) -> dict[str, li
 
     Raises ModelError (or GeometryError for a mesh file) when the URDF or a visual cannot be
     read; a viewer then draws the collision shapes instead.
+
+    Args:
+        urdf: the URDF file.
+        package_dirs: folders that hold the packages its package:// meshes name.
+
+    Returns:
+        Each link's visuals, by link name; links without <visual> are left out.
     """
     try:
         root = ET.parse(urdf).getroot()

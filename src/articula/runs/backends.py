@@ -20,7 +20,11 @@ CONNECT_TIMEOUT = 3.0  # [s] to reach a Dask scheduler before any work starts
 
 def check_backend(dask: str | None) -> None:
     """ConfigError for a --dask value that is neither 'local' nor a reachable tcp://HOST:PORT
-    (tried now, within CONNECT_TIMEOUT, so that a wrong address fails before any work)."""
+    (tried now, within CONNECT_TIMEOUT, so that a wrong address fails before any work).
+
+    Args:
+        dask: the --dask value: None (no Dask), "local" or "tcp://HOST:PORT" of a scheduler.
+    """
     if dask is None or dask == "local":
         return
     host, _, port = dask.removeprefix("tcp://").rpartition(":")
@@ -40,7 +44,19 @@ def execute_all(
     dask: str | None,
 ) -> Iterator[T]:
     """task(config) for every config, yielded in completion order from the chosen backend;
-    never more worker processes than configs."""
+    never more worker processes than configs.
+
+    Args:
+        task: the function run on each config (picklable, for a pool or Dask).
+        configs: the configs, one task call each.
+        workers: most worker processes (1 or fewer without Dask: run in this process); also
+            the number of workers of a local Dask cluster.
+        dask: None for this process or a local process pool, "local" for a loopback Dask
+            cluster, "tcp://HOST:PORT" to join a Dask scheduler.
+
+    Yields:
+        task(config) of each config, in completion order (not the order of `configs`).
+    """
     if not configs:
         return
     workers = min(workers, len(configs))
@@ -59,7 +75,11 @@ def execute_all(
 
 def die_with_parent(parent: int) -> None:
     """Pool initializer: on Linux the kernel kills this worker when its parent dies (even by
-    SIGKILL), so a killed sweep leaves no worker behind; elsewhere nothing changes."""
+    SIGKILL), so a killed sweep leaves no worker behind; elsewhere nothing changes.
+
+    Args:
+        parent: process id of the process that started the pool.
+    """
     if sys.platform.startswith("linux"):
         libc = ctypes.CDLL(None, use_errno=True)
         libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL)

@@ -39,13 +39,28 @@ TEMPORARY = re.compile(r"^\.(?P<name>.+)\.[A-Za-z0-9_]{8}\.tmp$")
 
 
 def temporary_name_of(entry: str) -> str | None:
-    """The file a temporary file of atomic_write was to become, or None if `entry` is not one."""
+    """The file a temporary file of atomic_write was to become, or None if `entry` is not one.
+
+    Args:
+        entry: a name in a folder (no directory part).
+
+    Returns:
+        The name of the file it was to become, or None.
+    """
     match = TEMPORARY.match(entry)
     return match.group("name") if match else None
 
 
 def foreign_entries(folder: Path, kind: Kind) -> list[str]:
-    """Names in `folder` that articula would not have written there, sorted."""
+    """Names in `folder` that articula would not have written there, sorted.
+
+    Args:
+        folder: an existing output folder.
+        kind: what articula writes there: "run", "sweep", "report" or "suite".
+
+    Returns:
+        The foreign entry names, sorted; empty when everything in it is articula's.
+    """
     foreign = []
     for entry in sorted(os.listdir(folder)):
         name = temporary_name_of(entry) or entry
@@ -73,7 +88,13 @@ def foreign_entries(folder: Path, kind: Kind) -> list[str]:
 
 def check_out(folder: Path, kind: Kind, force: bool = False) -> None:
     """ConfigError unless `folder` can take articula's output: absent (with a creatable
-    path), an empty folder, or one articula wrote (`force` accepts any folder)."""
+    path), an empty folder, or one articula wrote (`force` accepts any folder).
+
+    Args:
+        folder: the output folder (--out).
+        kind: what articula writes there: "run", "sweep", "report" or "suite".
+        force: accept a folder holding files articula did not write.
+    """
     if folder.exists() and not folder.is_dir():
         raise ConfigError("--out", f"{_shown(folder)} is a file; give a folder path")
     if not folder.exists():
@@ -100,7 +121,16 @@ def check_out(folder: Path, kind: Kind, force: bool = False) -> None:
 @contextmanager
 def claimed(folder: Path, kind: Kind, force: bool = False) -> Iterator[Path]:
     """Create `folder` if needed, check it (see check_out), hold its lock while the body runs,
-    and first remove the temporary files a killed writer left there."""
+    and first remove the temporary files a killed writer left there.
+
+    Args:
+        folder: the output folder (--out).
+        kind: what articula writes there: "run", "sweep", "report" or "suite".
+        force: accept a folder holding files articula did not write.
+
+    Yields:
+        `folder`, created and locked by this process.
+    """
     check_out(folder, kind, force)
     try:
         folder.mkdir(parents=True, exist_ok=True)
@@ -118,7 +148,12 @@ def claimed(folder: Path, kind: Kind, force: bool = False) -> Iterator[Path]:
 
 def remove_stale_temporaries(folder: Path, kind: Kind) -> None:
     """Remove atomic_write's temporary files of articula's own files in `folder` (and in its
-    run folders, for a sweep). Only the lock holder may call this."""
+    run folders, for a sweep). Only the lock holder may call this.
+
+    Args:
+        folder: the output folder, locked by this process.
+        kind: what articula writes there: "run", "sweep", "report" or "suite".
+    """
     own = {"run": RUN_FILES, "sweep": {RESULTS}, "report": {REPORT}, "suite": SUITE_FILES}[kind]
     for entry in os.listdir(folder):
         if temporary_name_of(entry) in own:
@@ -141,7 +176,14 @@ def _lock(fd: int, folder: Path) -> None:
 
 
 def holder(folder: Path) -> str:
-    """Who holds the lock of `folder`: "pid N: its command line", as far as /proc tells."""
+    """Who holds the lock of `folder`: "pid N: its command line", as far as /proc tells.
+
+    Args:
+        folder: a locked output folder.
+
+    Returns:
+        "pid N: its command line", or "unknown" when /proc does not tell.
+    """
     st = folder.stat()
     device = f"{os.major(st.st_dev):02x}:{os.minor(st.st_dev):02x}:{st.st_ino}"
     try:

@@ -34,6 +34,12 @@ def config_hash(config: Mapping[str, Any]) -> str:
 
     The version is hashed too, so that a sweep resumed after an upgrade recomputes its runs
     instead of mixing results of two versions of the code.
+
+    Args:
+        config: a full config (defaults filled in), with its `experiment` key.
+
+    Returns:
+        The first 12 hex digits of the SHA-256 of the config and the articula version.
     """
     payload = {"config": dict(config), "articula": __version__}
     canonical = json.dumps(payload, sort_keys=True, separators=(",", ":"))
@@ -41,7 +47,11 @@ def config_hash(config: Mapping[str, Any]) -> str:
 
 
 def package_versions() -> dict[str, str]:
-    """Versions of Python and of the packages that decide the numbers."""
+    """Versions of Python and of the packages that decide the numbers.
+
+    Returns:
+        Version strings by name ("python", "numpy", ...); "not installed" for a missing one.
+    """
     versions = {"python": platform.python_version()}
     for name in _VERSIONED:
         try:
@@ -55,7 +65,18 @@ def build_record(
     config: Mapping[str, Any], result: Result, wall_time: float, error: str | None = None
 ) -> dict[str, Any]:
     """The JSON-ready record of one run; `error` says why a run of a sweep could not be done
-    (its metrics are then empty)."""
+    (its metrics are then empty).
+
+    Args:
+        config: the run's full config, with its `experiment` key.
+        result: what the experiment returned; its metrics are recorded (non-finite as null).
+        wall_time: the run's wall-clock time [s].
+        error: why the run could not be done, or None for a run that was done.
+
+    Returns:
+        The record: experiment, seed, config_hash, metrics, versions, wall_time_s and, for a
+        run that could not be done, error.
+    """
     record = {
         "experiment": config["experiment"],
         "seed": config.get("seed"),
@@ -78,6 +99,12 @@ def write_run(
     """Write a complete run folder; record.json goes last and marks the run finished.
 
     The caller holds the folder (folders.claimed) or writes into a sweep folder it holds.
+
+    Args:
+        folder: the run folder; created if needed.
+        config: the run's full config, written as config.toml.
+        record: the run's record (build_record), written as record.json.
+        trace: the run's time-series columns by name, equally long, written as trace.parquet.
     """
     make_folder(folder)
     atomic_write(folder / CONFIG, tomli_w.dumps(dict(config)).encode())
@@ -89,7 +116,11 @@ def write_run(
 
 
 def make_folder(path: Path) -> None:
-    """Create an output folder, with a clear error when a file is in the way."""
+    """Create an output folder, with a clear error when a file is in the way.
+
+    Args:
+        path: the folder to create, with any missing parents.
+    """
     if path.exists() and not path.is_dir():
         raise ConfigError("--out", f"{path} is a file; give a folder path")
     try:
@@ -104,6 +135,13 @@ def is_finished(folder: Path, config_hash_: str | None = None) -> bool:
 
     A folder that fails any check (a run killed between files, a truncated or foreign file)
     is not finished, and resuming recomputes it.
+
+    Args:
+        folder: a run folder (it need not exist).
+        config_hash_: the config_hash its record must carry, or None to accept any.
+
+    Returns:
+        Whether the folder holds a complete run (of that config, when given).
     """
     try:
         record = read_record(folder)
@@ -115,25 +153,49 @@ def is_finished(folder: Path, config_hash_: str | None = None) -> bool:
 
 
 def read_record(folder: Path) -> dict[str, Any]:
-    """The record.json of a finished run."""
+    """The record.json of a finished run.
+
+    Args:
+        folder: the run folder.
+
+    Returns:
+        The record (see build_record).
+    """
     return json.loads((folder / RECORD).read_text())
 
 
 def read_trace(folder: Path) -> dict[str, np.ndarray]:
-    """The trace.parquet of a run folder as columns."""
+    """The trace.parquet of a run folder as columns.
+
+    Args:
+        folder: the run folder.
+
+    Returns:
+        The trace's columns by name, each shape (samples,).
+    """
     table = pq.read_table(folder / TRACE)
     return {name: table[name].to_numpy() for name in table.column_names}
 
 
 def write_table(path: Path, table: pa.Table) -> None:
-    """Write a Parquet table atomically."""
+    """Write a Parquet table atomically.
+
+    Args:
+        path: the .parquet file to write; its folder must exist.
+        table: the table to write.
+    """
     sink = pa.BufferOutputStream()
     pq.write_table(table, sink)
     atomic_write(path, sink.getvalue().to_pybytes())
 
 
 def atomic_write(path: Path, data: bytes) -> None:
-    """Write to a temporary file beside `path`, flush it to disk, then rename over `path`."""
+    """Write to a temporary file beside `path`, flush it to disk, then rename over `path`.
+
+    Args:
+        path: the file to write; its folder must exist.
+        data: the file's full contents.
+    """
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
         with os.fdopen(fd, "wb") as f:

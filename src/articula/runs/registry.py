@@ -27,14 +27,27 @@ Progress = Callable[[int, int], None]  # (done, total) of a run's steps
 
 @dataclass(frozen=True)
 class Result:
-    """What an experiment returns: scalar metrics and equally long time-series columns."""
+    """What an experiment returns: scalar metrics and equally long time-series columns.
+
+    Attributes:
+        metrics: the run's scalar metrics by name (units as the experiment defines them).
+        trace: the run's time-series columns by name, each shape (samples,).
+    """
 
     metrics: dict[str, float]
     trace: dict[str, np.ndarray]
 
 
 def _no_paths(data: dict[str, Any], base_dir: Path) -> dict[str, Any]:
-    """The default path hook: a config without file paths is returned as it is."""
+    """The default path hook: a config without file paths is returned as it is.
+
+    Args:
+        data: a raw config mapping.
+        base_dir: the folder of its file (unused).
+
+    Returns:
+        `data` itself.
+    """
     return data
 
 
@@ -64,12 +77,24 @@ def _entry_points() -> dict[str, metadata.EntryPoint]:
 
 
 def names() -> list[str]:
-    """Names of every installed experiment, sorted."""
+    """Names of every installed experiment, sorted.
+
+    Returns:
+        The entry-point names of the `articula.experiments` group, sorted.
+    """
     return sorted(_entry_points())
 
 
 def experiment(name: str, where: str = "") -> Experiment:
-    """The installed experiment called `name`; the error for an unknown one names `where`."""
+    """The installed experiment called `name`; the error for an unknown one names `where`.
+
+    Args:
+        name: the experiment's name (a config's `experiment` value).
+        where: the config's file, named in the error ("" for none).
+
+    Returns:
+        The Experiment its entry point names.
+    """
     entry = _entry_points().get(name)
     if entry is None:
         known = ", ".join(names()) or "none installed (pip install -e . registers them)"
@@ -83,7 +108,15 @@ def experiment(name: str, where: str = "") -> Experiment:
 
 def parse_config(data: Mapping[str, Any], where: str = "") -> tuple[Experiment, BaseModel]:
     """Validate a config mapping (with its `experiment` key) into its experiment's model;
-    errors are prefixed with `where` (a file name) when given."""
+    errors are prefixed with `where` (a file name) when given.
+
+    Args:
+        data: a config mapping with its `experiment` key.
+        where: the config's file, prefixed to error fields ("" for none).
+
+    Returns:
+        The experiment and its validated config model (without `experiment`).
+    """
     body = dict(data)
     if "experiment" not in body:
         field = f"{where}: experiment" if where else "experiment"
@@ -93,7 +126,15 @@ def parse_config(data: Mapping[str, Any], where: str = "") -> tuple[Experiment, 
 
 
 def config_to_dict(exp: Experiment, config: BaseModel) -> dict[str, Any]:
-    """The full config (defaults filled in) as a plain mapping with its `experiment` key."""
+    """The full config (defaults filled in) as a plain mapping with its `experiment` key.
+
+    Args:
+        exp: the experiment.
+        config: its validated config model.
+
+    Returns:
+        The JSON-ready config, `experiment` first; fields that are None are left out.
+    """
     return {"experiment": exp.name, **config.model_dump(mode="json", exclude_none=True)}
 
 
@@ -101,6 +142,13 @@ def with_absolute_paths(data: Mapping[str, Any], base_dir: Path) -> dict[str, An
     """A config read from a file in `base_dir`, its file paths made absolute by its experiment.
 
     A config without a valid `experiment` key is returned unchanged: validation reports it.
+
+    Args:
+        data: a config mapping as read from its file.
+        base_dir: the folder of that file, where its relative paths start.
+
+    Returns:
+        A copy of the config with its file paths absolute.
     """
     body = dict(data)
     name = body.get("experiment")

@@ -24,7 +24,13 @@ FLAT_LIST_LIMIT = 16  # results.parquet spreads a config list this long or short
 
 @dataclass(frozen=True)
 class RunOutput:
-    """A finished run as it travels back from a worker: config, record and trace."""
+    """A finished run as it travels back from a worker: config, record and trace.
+
+    Attributes:
+        config: the run's full config (defaults filled in), with its `experiment` key.
+        record: the run's record (records.build_record).
+        trace: the run's time-series columns by name; empty for a run that could not be done.
+    """
 
     config: dict[str, Any]
     record: dict[str, Any]
@@ -35,7 +41,16 @@ def execute(
     config: Mapping[str, Any], where: str = "", progress: Progress | None = None
 ) -> RunOutput:
     """Validate and run one config (a mapping with its `experiment` key); validation errors
-    name `where` (its file) when given; `progress` is handed to the experiment."""
+    name `where` (its file) when given; `progress` is handed to the experiment.
+
+    Args:
+        config: a config mapping with its `experiment` key.
+        where: the config's file, prefixed to error fields ("" for none).
+        progress: called with (steps done, total steps) of the run, or None.
+
+    Returns:
+        The finished run.
+    """
     exp, model = parse_config(config, where)
     full = config_to_dict(exp, model)
     start = time.perf_counter()
@@ -47,7 +62,14 @@ def execute(
 
 def named_by_file(where: str) -> AbstractContextManager[None]:
     """Prefix the field of a ConfigError or InfeasibleError raised inside with `where` (the
-    config's file), as validation errors are; without `where`, leave errors as they are."""
+    config's file), as validation errors are; without `where`, leave errors as they are.
+
+    Args:
+        where: the config's file ("" leaves errors as they are).
+
+    Returns:
+        A context manager renaming the errors raised inside it.
+    """
     if not where:
         return nullcontext()
     return fields_renamed(lambda field: f"{where}: {field}" if field else where)
@@ -57,7 +79,14 @@ def execute_or_fail(config: Mapping[str, Any]) -> RunOutput:
     """execute(config), or, for a config that cannot be done (InfeasibleError: a start in
     collision, a path out of reach), a run whose record says why, so that one such point
     of a sweep does not stop the others; resuming does not retry it (the same config fails
-    the same way)."""
+    the same way).
+
+    Args:
+        config: a config mapping with its `experiment` key.
+
+    Returns:
+        The finished run, or one with empty metrics and trace whose record carries `error`.
+    """
     try:
         return execute(config)
     except InfeasibleError as exc:
@@ -67,7 +96,14 @@ def execute_or_fail(config: Mapping[str, Any]) -> RunOutput:
 
 
 def normalized(config: Mapping[str, Any]) -> dict[str, Any]:
-    """A config validated and completed with its defaults, as its run folder records it."""
+    """A config validated and completed with its defaults, as its run folder records it.
+
+    Args:
+        config: a config mapping with its `experiment` key.
+
+    Returns:
+        The full config as a plain mapping (config_to_dict).
+    """
     return config_to_dict(*parse_config(config))
 
 
@@ -83,6 +119,17 @@ def run_to_folder(
     Bad input, and an `out` that is a file or holds files articula did not write (unless
     `force`), fail before the run starts; nothing is written then. The folder is held while
     its files are written, so two processes writing one folder never mix their files.
+
+    Args:
+        config: a config mapping with its `experiment` key.
+        out: the run folder to write.
+        where: the config's file, prefixed to error fields ("" for none).
+        force: write into an `out` holding files articula did not write (only articula's own
+            files are replaced).
+        progress: called with (steps done, total steps) of the run, or None.
+
+    Returns:
+        The run's record, as written to record.json.
     """
     parse_config(config, where)
     check_out(out, "run", force)
@@ -106,6 +153,18 @@ def run_sweep(
     by the same hash whether its config came complete (from expand_sweep) or partial. The
     sweep holds `out` while it runs (a second sweep into it is refused); a run folder counts
     as finished only if all its files are there and readable (records.is_finished).
+
+    Args:
+        configs: the sweep's configs, each with its `experiment` key (complete or partial).
+        out: the sweep folder; each run goes to a subfolder named by its config hash.
+        workers: most worker processes (see backends.execute_all).
+        dask: None, "local" or "tcp://HOST:PORT" of a Dask scheduler (see backends.execute_all).
+        progress: called with (runs done, total runs), finished runs of before included, or
+            None.
+        force: write into an `out` holding files articula did not write.
+
+    Returns:
+        The results table (results_table), as written to results.parquet.
     """
     check_backend(dask)
     configs = [normalized(c) for c in configs]
@@ -129,7 +188,16 @@ def run_sweep(
 
 def results_table(configs: Sequence[Mapping[str, Any]], out: Path) -> pa.Table:
     """One row per run: its hash, flattened config values, metrics, and `error` (null, or why
-    the run could not be done)."""
+    the run could not be done).
+
+    Args:
+        configs: the full configs of the sweep's runs, every one finished.
+        out: the sweep folder holding their run folders.
+
+    Returns:
+        One row per config, in order: run (the hash), config values by dotted key, metrics,
+        wall_time_s [s] and error.
+    """
     rows = []
     for cfg in configs:
         h = records.config_hash(cfg)

@@ -28,6 +28,16 @@ def expand_sweep(
     a bad sweep fails before anything runs. File paths in the configs start at `base_dir`
     (the sweep file's folder) and come out absolute. A sweep of more than `max_runs` configs
     is refused before any is built. Errors name `where` (the sweep file) and the point.
+
+    Args:
+        spec: the sweep file's tables: `base`, `grid` and `runs` (each optional).
+        base_dir: the folder relative file paths start at (the sweep file's), or None to
+            leave paths as they are.
+        max_runs: the most configs the sweep may have.
+        where: the sweep file, named in errors ("" for none).
+
+    Returns:
+        The full, validated configs: every `runs` entry for each grid point in turn.
     """
     unknown = set(spec) - {"base", "grid", "runs"}
     if unknown:

@@ -16,7 +16,14 @@ MAX_ROWS = 100_000  # configurations of one --q-file
 
 
 def parse_q(text: str) -> np.ndarray:
-    """Joint values from "q1,q2,..." [rad]."""
+    """Joint values from "q1,q2,..." [rad].
+
+    Args:
+        text: comma-separated joint values, as given to --q [rad].
+
+    Returns:
+        The joint values, shape (n,) [rad].
+    """
     try:
         return np.array([float(v) for v in text.replace(" ", "").split(",") if v != ""])
     except ValueError:
@@ -25,7 +32,16 @@ def parse_q(text: str) -> np.ndarray:
 
 def read_q_file(path: Path, nq: int, max_rows: int = MAX_ROWS) -> np.ndarray:
     """Configurations [rad], one per row, from a CSV (a header line is allowed) or Parquet file
-    of `nq` numeric columns."""
+    of `nq` numeric columns.
+
+    Args:
+        path: the .csv or .parquet file (--q-file).
+        nq: number of joints, the columns each row must have.
+        max_rows: most configurations the file may hold.
+
+    Returns:
+        The configurations, shape (rows, nq) [rad].
+    """
     if not path.is_file():
         raise ConfigError("--q-file", f"{path}: file not found")
     try:
@@ -60,7 +76,20 @@ def check_scene(
     path: Path, q_text: str | None = None, metric: str = "gjk", q_file: Path | None = None
 ) -> dict[str, Any]:
     """End-effector position, clearances per link and obstacle, and whether anything collides,
-    at q0, at --q, or (with --q-file) at every row of a file: {"configurations": [...]}."""
+    at q0, at --q, or (with --q-file) at every row of a file: {"configurations": [...]}.
+
+    Args:
+        path: the scene TOML file.
+        q_text: joint values "q1,q2,..." [rad] (--q); None for the scene's q0.
+        metric: "gjk" (exact convex distance) or "vertex" (the book's Sect. 1.3.3 formula).
+        q_file: a CSV or Parquet file of configurations (--q-file), or None.
+
+    Returns:
+        The summary of the configuration: q [rad], ee_position [m], min_clearance [m],
+        link_clearance and obstacle_clearance by name [m], self_clearance [m],
+        self_closest_pair, self_collides, self_collision_checked, collides, within_limits and
+        metric; with `q_file`, {"configurations": [one summary per row]}.
+    """
     spec = load_scene_spec(load_toml(path), str(path))
     if metric not in ("gjk", "vertex"):
         raise ConfigError("--metric", f"unknown metric {metric!r}; choose gjk or vertex")

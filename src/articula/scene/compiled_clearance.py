@@ -14,19 +14,15 @@ come out apart.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import ClassVar
 
 import numpy as np
 import pinocchio as pin
-from scipy.spatial import ConvexHull
 
-from articula.geometry.shapes import ConvexShape
 from articula.numba_cache import jit
+from articula.scene.compiled_arrays import _capsule_ends, _core, _edges, _pair_rows, _reach
 from articula.scene.compiled_poses import (
-    _apply,
-    _capsule_gaps,
     _ee_pose,
     _joint_poses,
     _moved,
@@ -36,6 +32,7 @@ from articula.scene.compiled_poses import (
     _segment_distance,
     _shape_poses,
 )
+from articula.scene.compiled_pruning import _near_pairs
 from articula.scene.gjk import gjk_distance
 from articula.scene.scene import Scene
 
@@ -46,7 +43,40 @@ _AXES = {"JointModelRX": (1.0, 0.0, 0.0), "JointModelRY": (0.0, 1.0, 0.0),
 
 @dataclass(frozen=True)
 class CompiledClearance:
-    """Arrays of a Scene for `evaluate`: kinematic chain, shape cores, capsules and pairs."""
+    """Arrays of a Scene for `evaluate`: kinematic chain, shape cores, capsules and pairs.
+
+    Attributes:
+        parents: parent joint index of each joint, shape (joints,); joint 0 is the world.
+        joint_rot: rotation of each joint's placement in its parent joint frame, (joints, 3, 3).
+        joint_p: position of each joint's placement in its parent joint frame, (joints, 3) [m].
+        axes: revolute axis of each joint in its own frame, shape (joints, 3) (unit vectors).
+        q_index: index of each joint's angle in q, shape (joints,).
+        ee_joint: the joint the end-effector frame moves with.
+        ee_p: end-effector origin in its joint frame, shape (3,) [m].
+        ee_rot: end-effector orientation in its joint frame, shape (3, 3).
+        vertices: core vertices of every shape in its own frame, concatenated, (total, 3) [m].
+        starts: where each shape's vertices start in `vertices`, shape (shapes + 1,).
+        neighbours: vertices joined by a hull edge, CSR by vertex (indices into `vertices`).
+        offsets: CSR offsets of each vertex's neighbours, shape (total + 1,).
+        hints: vertex each shape's support search starts from, shape (shapes,) (scratch).
+        simplices: each pair's GJK warm start (gjk.py), shape (pairs, 7) (scratch).
+        memory: each pair's last exact distance [m] and the two shapes' poses (R, p) then,
+            shape (pairs, 25) (scratch; distance −inf: none yet).
+        extents: largest |x| of a core vertex in its shape's frame, shape (shapes,) [m].
+        radii: radius swept around each core (sphere, capsule; 0 for a polytope), (shapes,) [m].
+        shape_joint: the joint each shape moves with, shape (shapes,) (0: the world).
+        shape_rot: rotation of each shape in its joint frame (world for obstacles), (shapes, 3, 3).
+        shape_p: position of each shape in its joint frame (world for obstacles), (shapes, 3) [m].
+        capsule_a: first end of each bounding capsule's segment, shape frame, (shapes, 3) [m].
+        capsule_b: second end of each bounding capsule's segment, shape frame, (shapes, 3) [m].
+        capsule_r: radius of each bounding capsule, shape (shapes,) [m].
+        pairs: rows (shape a, shape b, cache row, OBSTACLE | SELF, cell) of the pairs that move,
+            shape (pairs, 5).
+        cells: number of cells: (link, obstacle) cells row-major, then the checked link pairs.
+        static_min: smallest distance of the pairs that never move, per kind, shape (2,) [m].
+        reach: no shape point is farther than this from any joint origin, in any pose [m].
+        moving_parts: (shape index, its obstacle) of each part of a moving obstacle.
+    """
 
     parents: np.ndarray  # (joints,) parent joint index; joint 0 is the world
     joint_rot: np.ndarray  # (joints, 3, 3) joint placement in the parent joint frame
@@ -81,7 +111,14 @@ class CompiledClearance:
 
     @classmethod
     def build(cls, scene: Scene) -> CompiledClearance | None:
-        """The arrays of `scene`, or None when it needs something this path does not cover."""
+        """The arrays of `scene`, or None when it needs something this path does not cover.
+
+        Args:
+            scene: the scene to compile.
+
+        Returns:
+            Its arrays; None for the vertex metric, a joint that is not revolute or a cylinder.
+        """
         model = scene.robot.model
         names = [model.joints[j].shortname() for j in range(1, model.njoints)]
         if scene.metric != "gjk":
@@ -168,7 +205,11 @@ class CompiledClearance:
 
     def at(self, t: float) -> None:
         """Put the moving obstacles' shapes at their poses of time t [s] (in place), and lower
-        the remembered bounds of their pairs by how far each moved."""
+        the remembered bounds of their pairs by how far each moved.
+
+        Args:
+            t: time [s].
+        """
         for shape, obstacle in self.moving_parts:
             _place(shape, obstacle.pose_at(t), self.shape_rot, self.shape_p, self.extents,
                    self.memory, self.pairs)  # fmt: skip
@@ -180,13 +221,31 @@ class CompiledClearance:
     ) -> tuple[float, float, np.ndarray, np.ndarray]:
         """(obstacle clearance [m], self clearance [m], end-effector position [m] and rotation
         (3×3, world)) at q [rad]; a clearance is 0 on overlap and +inf without pairs of its
-        kind or when not asked for (both False: kinematics only)."""
+        kind or when not asked for (both False: kinematics only).
+
+        Args:
+            q: joint angles, shape (nq,) [rad].
+            obstacles: whether to measure the link-obstacle clearance.
+            self_pairs: whether to measure the clearance of the checked link pairs.
+
+        Returns:
+            (obstacle clearance [m], self clearance [m], end-effector position, shape (3,) [m],
+            end-effector rotation, shape (3, 3)).
+        """
         pairs, static_min = self.select(obstacles, self_pairs)
         return _evaluate(q, *self.arrays(pairs), static_min)
 
     def select(self, obstacles: bool, self_pairs: bool) -> tuple[np.ndarray, np.ndarray]:
         """(pairs, static_min) of the kinds asked for; the others count as +inf (read-only:
-        the same arrays every call)."""
+        the same arrays every call).
+
+        Args:
+            obstacles: whether to keep the link-obstacle pairs.
+            self_pairs: whether to keep the checked link pairs.
+
+        Returns:
+            (the rows of `pairs` of those kinds, static_min with +inf for the others [m]).
+        """
         kinds = (bool(obstacles), bool(self_pairs))
         if kinds not in self._selected:
             keep = np.array(kinds)
@@ -202,6 +261,13 @@ class CompiledClearance:
         a pair stays above its lower bound at c less that δ, and the smallest distance stays
         below the smallest upper bound at c plus δ: a pair whose lower bound exceeds that by
         2δ can never be the minimum (nor reach GJK in `_evaluate`'s broad phase).
+
+        Args:
+            pairs: pair rows, as in `pairs`, shape (k, 5).
+            box: (lower, upper) joint angles, each shape (nq,) [rad].
+
+        Returns:
+            The rows kept, shape (k', 5).
         """
         return _near_pairs(box[0], box[1], self.reach, self.static_min[OBSTACLE], self.parents,
                            self.joint_rot, self.joint_p, self.axes, self.q_index, self.vertices,
@@ -210,70 +276,20 @@ class CompiledClearance:
                            pairs)  # fmt: skip
 
     def arrays(self, pairs: np.ndarray | None = None) -> tuple:
-        """The arguments of the compiled evaluation after q (all but static_min)."""
+        """The arguments of the compiled evaluation after q (all but static_min).
+
+        Args:
+            pairs: the pair rows to evaluate, shape (k, 5); None for all of `pairs`.
+
+        Returns:
+            The arrays, in `_evaluate`'s order, ending with the pair rows.
+        """
         pairs = self.pairs if pairs is None else pairs
         return (self.parents, self.joint_rot, self.joint_p, self.axes, self.q_index,
                 self.ee_joint, self.ee_p, self.ee_rot, self.vertices, self.starts, self.neighbours,
                 self.offsets, self.hints, self.simplices, self.memory, self.extents, self.radii,
                 self.shape_joint, self.shape_rot, self.shape_p, self.capsule_a, self.capsule_b,
                 self.capsule_r, pairs)  # fmt: skip
-
-
-def _reach(placements: list, poses: list[np.ndarray], cores: list) -> float:
-    """A bound [m] on the distance between any point of a link shape and any joint origin:
-    every joint origin lies within Σ|joint offsets| of the base, and every shape point within
-    that plus its own extent."""
-    chain = float(sum(np.linalg.norm(p.translation) for p in placements))
-    extent = max(
-        (np.linalg.norm(T[:3, 3]) + float(np.max(np.linalg.norm(core[0], axis=1))) + core[1]
-         for T, core in zip(poses, cores, strict=True)),
-        default=0.0,
-    )  # fmt: skip
-    return 2.0 * chain + extent
-
-
-def _pair_rows(pairs: list[tuple[int, int, int, int]], index: dict) -> np.ndarray:
-    """(shape a, shape b, cache row, kind, cell) rows of `pairs`."""
-    rows = [(a, b, index[a, b, kind, cell], kind, cell) for a, b, kind, cell in pairs]
-    return np.array(rows, dtype=np.int64).reshape(-1, 5)
-
-
-def _core(shape: ConvexShape) -> tuple[np.ndarray, float] | None:
-    """(core vertices, radius) of a shape, or None for a shape GJK here cannot represent."""
-    if shape.kind in ("convex", "box"):
-        return np.asarray(shape.vertices, dtype=float), 0.0
-    if shape.kind == "sphere":
-        return np.zeros((1, 3)), float(shape.geometry.radius)
-    if shape.kind == "capsule":
-        half = float(shape.geometry.halfLength)
-        return np.array([[0.0, 0.0, -half], [0.0, 0.0, half]]), float(shape.geometry.radius)
-    return None  # cylinders: round rims are not a swept polytope
-
-
-def _edges(cores: list[np.ndarray], starts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Hull-edge adjacency of every core as CSR arrays over the concatenated vertices; cores of
-    one or two points (spheres, capsules) are joined completely."""
-    lists: list[set[int]] = []
-    for core, first in zip(cores, starts, strict=False):
-        local = [set() for _ in range(len(core))]
-        if len(core) >= 4:
-            for tri in ConvexHull(core).simplices:
-                for i in range(3):
-                    a, b = int(tri[i]), int(tri[(i + 1) % 3])
-                    local[a].add(b)
-                    local[b].add(a)
-        else:
-            local = [set(range(len(core))) - {i} for i in range(len(core))]
-        lists += [{int(first) + m for m in nbrs} for nbrs in local]
-    offsets = np.cumsum([0] + [len(n) for n in lists]).astype(np.int64)
-    flat = [m for nbrs in lists for m in sorted(nbrs)]
-    return np.array(flat, dtype=np.int64), offsets
-
-
-def _capsule_ends(shape: ConvexShape) -> tuple[np.ndarray, np.ndarray, float]:
-    """The bounding capsule as its two segment ends (shape frame) and radius."""
-    T, half = shape.bound.pose, shape.bound.length / 2
-    return T[:3, 3] - half * T[:3, 2], T[:3, 3] + half * T[:3, 2], shape.bound.radius
 
 
 @jit()
@@ -289,48 +305,6 @@ def _place(shape, T, shape_rot, shape_p, extents, memory, pairs):  # fmt: skip
                 memory[pairs[k, 2], 0] -= moved
         shape_rot[shape] = R
         shape_p[shape] = p
-
-
-@jit()
-def _pair_bounds(
-    q, parents, joint_rot, joint_p, axes, q_index, vertices, starts, radii, shape_joint,
-    shape_rot, shape_p, capsule_a, capsule_b, capsule_r, pairs,
-):  # fmt: skip
-    """(lower, upper) bounds of every pair's distance at q: its capsules' gap, and the gap
-    between the balls of radius r around one core point of each shape."""
-    oR, op = _joint_poses(q, parents, joint_rot, joint_p, axes, q_index)
-    world_R, world_p, ends = _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a,
-                                          capsule_b, pairs)  # fmt: skip
-    upper = np.empty(pairs.shape[0])
-    point_a = np.empty(3)
-    point_b = np.empty(3)
-    for k in range(pairs.shape[0]):
-        a, b = pairs[k, 0], pairs[k, 1]
-        _apply(world_R[a], world_p[a], vertices[starts[a]], point_a)
-        _apply(world_R[b], world_p[b], vertices[starts[b]], point_b)
-        gap = point_a - point_b
-        upper[k] = math.sqrt(gap @ gap) - radii[a] - radii[b]
-    return _capsule_gaps(ends, capsule_r, pairs), upper
-
-
-@jit()
-def _near_pairs(
-    lower, upper, reach, static_min, parents, joint_rot, joint_p, axes, q_index, vertices,
-    starts, radii, shape_joint, shape_rot, shape_p, capsule_a, capsule_b, capsule_r, pairs,
-):  # fmt: skip
-    """CompiledClearance.near_pairs in one compiled call (it runs once per control period)."""
-    centre = (lower + upper) / 2.0
-    delta = reach * np.sum(upper - lower) / 2.0
-    below, above = _pair_bounds(centre, parents, joint_rot, joint_p, axes, q_index, vertices,
-                                starts, radii, shape_joint, shape_rot, shape_p, capsule_a,
-                                capsule_b, capsule_r, pairs)  # fmt: skip
-    ceiling = static_min
-    for k in range(pairs.shape[0]):
-        if pairs[k, 3] == 0 and above[k] < ceiling:
-            ceiling = above[k]
-    ceiling += 2.0 * delta
-    keep = np.array([pairs[k, 3] != 0 or below[k] <= ceiling for k in range(pairs.shape[0])])
-    return pairs[keep]
 
 
 @jit()

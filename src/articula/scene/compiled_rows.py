@@ -38,6 +38,16 @@ def clearance_rows(
     pairs; each row is the closest of its cell's shape pairs, ∇d = n·(J_a − J_b) at the
     witness points, n the unit vector from b's closest point to a's (b: the obstacle or the
     pair's second link). A row no joint moves is left out.
+
+    Args:
+        compiled: the scene's arrays (its obstacles do not move).
+        q: joint positions, shape (nq,) [rad].
+        influence: distance below which a cell or link pair gives a row [m].
+
+    Returns:
+        (ee position, shape (3,) [m]; ee rotation, shape (3, 3); Jacobian, shape (6, nq),
+        linear rows [m/rad] then angular rows; distances, shape (rows,) [m]; gradients ∂d/∂q,
+        shape (rows, nq) [m/rad]; link-pair flags, shape (rows,) bool), or None on an overlap.
     """
     c = compiled
     out = _rows(q, c.parents, c.joint_rot, c.joint_p, c.axes, c.q_index, c.ee_joint, c.ee_p,

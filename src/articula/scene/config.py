@@ -42,7 +42,12 @@ PACKAGE_URI = "package://articula/"  # a file shipped inside articula
 
 
 class EeOffsetSpec(StrictModel):
-    """[robot] ee_offset: the tool point's pose in the ee_frame, xyz [m] and rpy [rad]."""
+    """[robot] ee_offset: the tool point's pose in the ee_frame, xyz [m] and rpy [rad].
+
+    Attributes:
+        xyz: position of the tool point in the ee_frame, shape (3,) [m].
+        rpy: roll, pitch, yaw of the tool frame in the ee_frame, shape (3,) [rad].
+    """
 
     xyz: Point = Field(default_factory=lambda: [0.0, 0.0, 0.0])
     rpy: Rpy = Field(default_factory=lambda: [0.0, 0.0, 0.0])
@@ -50,7 +55,24 @@ class EeOffsetSpec(StrictModel):
 
 class RobotSpec(StrictModel):
     """[robot]: a built-in robot or a URDF, and its initial configuration q0 [rad]; joints to
-    lock at fixed values [rad or m] and the tool point's offset from ee_frame."""
+    lock at fixed values [rad or m] and the tool point's offset from ee_frame.
+
+    Attributes:
+        builtin: name of a robot shipped with articula ("iiwa14"); give this or `urdf`.
+        urdf: path of the URDF file (relative to the scene file, or package://articula/...).
+        package_dirs: folders that hold the packages the URDF's package:// meshes name.
+        ee_frame: the end-effector frame; default the built-in robot's, or the last link.
+        ee_offset: pose of the tool point in the ee_frame, which then becomes the end effector.
+        locked_joints: joint name -> fixed value [rad or m]; these joints leave the model.
+        q0: initial joint positions, one per joint [rad]; default all zero.
+        max_links: largest URDF accepted, in links.
+        decompose: link meshes CoACD decomposes into convex parts: true for all, or link names.
+        self_collision: whether link-link distances count as clearance too.
+        allow_pairs: [a, b] link name pairs never checked for self-collision.
+        self_collision_samples: random configurations the allowed-collision matrix is built on.
+        self_collision_margin: a link pair never closer than this over the samples is not
+            checked [m].
+    """
 
     builtin: str | None = None
     urdf: str | None = None
@@ -82,7 +104,23 @@ class RobotSpec(StrictModel):
 
 
 class ObstacleSpec(StrictModel):
-    """[[obstacles]]: one shape (mesh file or primitive) with a pose; sizes in m."""
+    """[[obstacles]]: one shape (mesh file or primitive) with a pose; sizes in m.
+
+    Attributes:
+        name: the obstacle's name; default obstacle_<index>.
+        mesh: path of a mesh file (STL, OBJ, PLY, DAE), relative to the scene file.
+        scale: factor from the mesh file's units to metres, one or per axis (x, y, z).
+        decompose: whether CoACD decomposes the mesh into convex parts instead of one hull.
+        max_vertices: largest mesh, in vertices, a decomposition accepts.
+        box: edge lengths along x, y, z [m].
+        sphere: radius [m].
+        cylinder: radius and length along z [m].
+        capsule: radius and length along z between the caps' centres [m].
+        position: position of the obstacle frame in the world, shape (3,) [m].
+        rpy: roll, pitch, yaw of the obstacle frame in the world, shape (3,) [rad].
+        velocity: constant velocity of the obstacle from its position at t = 0, shape (3,)
+            [m/s]; None for a still obstacle.
+    """
 
     name: str | None = None
     mesh: str | None = None
@@ -108,14 +146,27 @@ class ObstacleSpec(StrictModel):
 
 
 class SceneSpec(StrictModel):
-    """A whole scene file."""
+    """A whole scene file.
+
+    Attributes:
+        robot: the [robot] table.
+        obstacles: the [[obstacles]] tables, in file order.
+    """
 
     robot: RobotSpec
     obstacles: list[ObstacleSpec] = Field(default_factory=list)
 
 
 def load_scene_spec(data: dict[str, Any], where: str = "") -> SceneSpec:
-    """Validate the [robot] and [[obstacles]] tables of a mapping (other keys are ignored)."""
+    """Validate the [robot] and [[obstacles]] tables of a mapping (other keys are ignored).
+
+    Args:
+        data: the parsed TOML file.
+        where: the file's name, prefixed to the field in errors.
+
+    Returns:
+        The validated scene.
+    """
     body = {k: data[k] for k in ("robot", "obstacles") if k in data}
     if "robot" not in body:
         raise ConfigError(f"{where}: robot" if where else "robot", "the [robot] table is missing")
@@ -125,7 +176,17 @@ def load_scene_spec(data: dict[str, Any], where: str = "") -> SceneSpec:
 def build_scene(
     spec: SceneSpec, base_dir: Path, broadphase: bool = True, metric: Metric = "gjk"
 ) -> tuple[Scene, np.ndarray]:
-    """The Scene and its initial configuration q0; relative paths start at `base_dir`."""
+    """The Scene and its initial configuration q0; relative paths start at `base_dir`.
+
+    Args:
+        spec: the validated scene file.
+        base_dir: folder relative paths are taken from (the scene file's).
+        broadphase: whether distance queries skip pairs by their bounding capsules.
+        metric: "gjk" (exact convex distance) or "vertex" (the book's Sect. 1.3.3 formula).
+
+    Returns:
+        The scene and q0, the initial joint positions, shape (nq,) [rad].
+    """
     r = spec.robot
     fields = {name: f"robot.{name}" for name in RobotSpec.model_fields}
     fields |= {f"locked_joints.{name}": f"robot.locked_joints.{name}" for name in r.locked_joints}
@@ -160,7 +221,15 @@ def build_scene(
 
 def robot_self_collision(spec: SceneSpec, robot: RobotModel) -> SelfCollisionMatrix:
     """The allowed-collision matrix a scene file's [robot] table asks for (whether or not
-    self_collision is on); errors name the [robot] key."""
+    self_collision is on); errors name the [robot] key.
+
+    Args:
+        spec: the validated scene file.
+        robot: the robot built from its [robot] table.
+
+    Returns:
+        The link pairs to check and the skipped ones.
+    """
     r = spec.robot
     with fields_as({"allow_pairs": "robot.allow_pairs"}):
         return self_collision_matrix(
@@ -206,7 +275,15 @@ def _primitive(spec: ObstacleSpec) -> ConvexShape:
 def resolve_path(base_dir: Path, text: str) -> Path:
     """A path from a scene file: `package://articula/...` inside the installed package (the
     same config then finds its files on any machine), `~` expanded, relative ones taken from
-    `base_dir`."""
+    `base_dir`.
+
+    Args:
+        base_dir: folder relative paths are taken from (the scene file's).
+        text: the path as written in the file.
+
+    Returns:
+        The path (not checked to exist).
+    """
     if text.startswith(PACKAGE_URI):
         return Path(str(resources.files("articula").joinpath(text.removeprefix(PACKAGE_URI))))
     path = Path(text).expanduser()

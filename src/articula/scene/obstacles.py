@@ -18,6 +18,12 @@ class Obstacle:
     """Named convex parts (in the obstacle frame) and the obstacle's pose in the world.
 
     `pose` is a 4×4 matrix, or a function of time t [s] returning one (a moving obstacle).
+
+    Attributes:
+        name: the obstacle's name, unique in a scene.
+        parts: its convex parts, in the obstacle frame.
+        pose: pose of the obstacle frame in the world, shape (4, 4) [m], or a function of
+            time t [s] that returns it.
     """
 
     name: str
@@ -36,7 +42,14 @@ class Obstacle:
         return callable(self.pose)
 
     def pose_at(self, t: float) -> np.ndarray:
-        """The obstacle's pose (4×4, world) at time t [s]."""
+        """The obstacle's pose (4×4, world) at time t [s].
+
+        Args:
+            t: time [s].
+
+        Returns:
+            The pose of the obstacle frame in the world, shape (4, 4) [m].
+        """
         if callable(self.pose):
             return check_pose(f"obstacle {self.name!r}", np.asarray(self.pose(t), dtype=float))
         return self.pose
@@ -44,7 +57,15 @@ class Obstacle:
 
 def check_pose(what: str, T: np.ndarray) -> np.ndarray:
     """T if it is a finite 4×4 pose with a rotation; GeometryError that starts with `what`
-    (e.g. "obstacle 'box'"). Cheap: a live loop checks every obstacle pose every period."""
+    (e.g. "obstacle 'box'"). Cheap: a live loop checks every obstacle pose every period.
+
+    Args:
+        what: what the pose belongs to, for the error message.
+        T: the pose to check, shape (4, 4) [m].
+
+    Returns:
+        T itself.
+    """
     if T.shape != (4, 4) or not np.isfinite(T).all():
         raise GeometryError(f"{what}: pose must be a finite 4×4 matrix (got {T.shape})")
     # det R and the entries of R Rᵀ − I, in scalars: numpy's per-call overhead would dominate.

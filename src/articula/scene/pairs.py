@@ -13,7 +13,13 @@ from articula.errors import ConfigError
 
 @dataclass(frozen=True)
 class Witnesses:
-    """Signed distances (links × obstacles) [m] and the closest points [m, world] per cell."""
+    """Signed distances (links × obstacles) [m] and the closest points [m, world] per cell.
+
+    Attributes:
+        distance: signed distance of each (link, obstacle) cell, shape (links, obstacles) [m].
+        on_link: closest point on the link, world, shape (links, obstacles, 3) [m].
+        on_obstacle: closest point on the obstacle, world, shape (links, obstacles, 3) [m].
+    """
 
     distance: np.ndarray
     on_link: np.ndarray  # (links, obstacles, 3)
@@ -23,7 +29,13 @@ class Witnesses:
 @dataclass(frozen=True)
 class SelfWitnesses:
     """Signed distance [m] of every checked link pair (a, b) and the closest points [m, world]
-    on link a and on link b."""
+    on link a and on link b.
+
+    Attributes:
+        distance: signed distance of each checked pair, shape (pairs,) [m].
+        on_a: closest point on link a of each pair, world, shape (pairs, 3) [m].
+        on_b: closest point on link b of each pair, world, shape (pairs, 3) [m].
+    """
 
     distance: np.ndarray  # (pairs,)
     on_a: np.ndarray  # (pairs, 3)
@@ -34,7 +46,16 @@ def link_pairs(
     pairs: Sequence[Sequence[str]], links: list[str], field: str
 ) -> tuple[tuple[int, int], ...]:
     """Link pairs by name as sorted index pairs into `links`, each once; ConfigError naming
-    `field` for an entry that is not two different links of the list."""
+    `field` for an entry that is not two different links of the list.
+
+    Args:
+        pairs: the link pairs, each two link names.
+        links: names of the links with collision shapes, in order.
+        field: the config field the pairs come from, for the error messages.
+
+    Returns:
+        The pairs as (a, b) indices into `links`, a < b, sorted and without repeats.
+    """
     out = set()
     for pair in pairs:
         if len(pair) != 2:

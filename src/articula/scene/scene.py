@@ -23,11 +23,10 @@ from articula.geometry.poses import transform_points
 from articula.geometry.shapes import ConvexShape
 from articula.robots.model import RobotModel
 from articula.scene.obstacles import Obstacle
+from articula.scene.pair_distances import _PairDistances
 from articula.scene.pairs import SelfWitnesses, Witnesses, link_pairs
 
 Metric = Literal["gjk", "vertex"]
-_NO_SUPPORT_GUESS = np.zeros(2, dtype=np.int32)
-_NO_GJK_GUESS = np.array([1.0, 0.0, 0.0])
 
 
 class _Geometry:
@@ -55,15 +54,19 @@ class _Geometry:
         self.bounds.addCollisionPair(pin.CollisionPair(a, b))
 
 
-class Scene:
+class Scene(_PairDistances):
     """A robot and its obstacles; distances for a joint configuration q at time t [s].
 
-    metric "gjk" (default): signed distance between convex shapes, negative penetration depth
-    when they overlap. metric "vertex": the book's Sect. 1.3.3 formula, the distance between
-    the closest pair of vertices, which over-states clearance (docs/deviations.md).
-
-    self_pairs: the link pairs (by name) whose distance counts as clearance too, usually
-    scene.self_collision.checked_pairs (every pair that is not adjacent and can come close).
+    Args:
+        robot: the arm; its links' collision shapes are measured.
+        obstacles: the obstacles, each with a unique name.
+        broadphase: whether queries skip the pairs whose bounding capsules show they cannot be
+            a minimum (metric "gjk").
+        metric: "gjk": signed distance between convex shapes, negative penetration depth when
+            they overlap. "vertex": the book's Sect. 1.3.3 formula, the distance between the
+            closest pair of vertices, which over-states clearance (docs/deviations.md).
+        self_pairs: the link pairs (by name) whose distance counts as clearance too, usually
+            self_collision_matrix(robot).checked (the pairs not adjacent that can come close).
     """
 
     def __init__(
@@ -166,11 +169,27 @@ class Scene:
     # ----- queries -----------------------------------------------------------------------------
 
     def distances(self, q: Sequence[float] | np.ndarray, t: float = 0.0) -> np.ndarray:
-        """Signed distance [m] from every link (rows) to every obstacle (columns)."""
+        """Signed distance [m] from every link (rows) to every obstacle (columns).
+
+        Args:
+            q: joint positions, nq values [rad or m].
+            t: time, for the poses of moving obstacles [s].
+
+        Returns:
+            The distances, shape (links, obstacles) [m].
+        """
         return self._cell_minima(self._pair_distances(self.robot.check_q(q), t))
 
     def witnesses(self, q: Sequence[float] | np.ndarray, t: float = 0.0) -> Witnesses:
-        """Distances with the closest point on the link and on the obstacle for each cell."""
+        """Distances with the closest point on the link and on the obstacle for each cell.
+
+        Args:
+            q: joint positions, nq values [rad or m].
+            t: time, for the poses of moving obstacles [s].
+
+        Returns:
+            The distances and closest points of every (link, obstacle) cell.
+        """
         return self.witnesses_within(q, t)[0]
 
     def witnesses_within(
@@ -179,7 +198,16 @@ class Scene:
         """Witnesses of every cell and of every checked link pair, from one pass; with the
         broad phase, a pair whose capsules are `within` [m] or farther apart is not computed,
         so a cell or link pair farther than that may read +inf (a controller that only acts
-        below an influence distance asks for no more)."""
+        below an influence distance asks for no more).
+
+        Args:
+            q: joint positions, nq values [rad or m].
+            t: time, for the poses of moving obstacles [s].
+            within: capsule distance from which a pair is not computed [m].
+
+        Returns:
+            (witnesses of the link-obstacle cells, witnesses of the checked link pairs).
+        """
         d = self._pair_distances(self.robot.check_q(q), t, every_pair=True, within=within)
         return self._witnesses(d), self._self_witnesses(d)
 
@@ -194,11 +222,25 @@ class Scene:
         return Witnesses(best, on_link, on_obstacle)
 
     def self_distances(self, q: Sequence[float] | np.ndarray) -> np.ndarray:
-        """Signed distance [m] of every link pair in `self_pairs`, in its order."""
+        """Signed distance [m] of every link pair in `self_pairs`, in its order.
+
+        Args:
+            q: joint positions, nq values [rad or m].
+
+        Returns:
+            The distances, shape (pairs,) [m].
+        """
         return self._self_minima(self._pair_distances(self.robot.check_q(q), 0.0, True))
 
     def self_witnesses(self, q: Sequence[float] | np.ndarray) -> SelfWitnesses:
-        """Self distances with the closest point on each link of each pair."""
+        """Self distances with the closest point on each link of each pair.
+
+        Args:
+            q: joint positions, nq values [rad or m].
+
+        Returns:
+            The distances and closest points of the checked link pairs.
+        """
         return self.witnesses_within(q)[1]
 
     def _self_witnesses(self, d: list[float]) -> SelfWitnesses:
@@ -212,17 +254,40 @@ class Scene:
         return SelfWitnesses(best, on_a, on_b)
 
     def self_clearance(self, q: Sequence[float] | np.ndarray) -> float:
-        """Smallest signed distance [m] between two links of a checked pair (inf without any)."""
+        """Smallest signed distance [m] between two links of a checked pair (inf without any).
+
+        Args:
+            q: joint positions, nq values [rad or m].
+
+        Returns:
+            The self clearance [m].
+        """
         return float(np.min(self.self_distances(q), initial=np.inf))
 
     def min_distance(self, q: Sequence[float] | np.ndarray, t: float = 0.0) -> float:
         """Smallest signed distance [m] between any link and any obstacle, or between the two
-        links of a checked self pair."""
+        links of a checked self pair.
+
+        Args:
+            q: joint positions, nq values [rad or m].
+            t: time, for the poses of moving obstacles [s].
+
+        Returns:
+            The clearance [m] (+inf without any pair).
+        """
         return min(self.clearances(q, t))
 
     def clearances(self, q: Sequence[float] | np.ndarray, t: float = 0.0) -> tuple[float, float]:
         """(smallest link-obstacle distance, smallest distance of a checked link pair) [m];
-        +inf for a kind without pairs."""
+        +inf for a kind without pairs.
+
+        Args:
+            q: joint positions, nq values [rad or m].
+            t: time, for the poses of moving obstacles [s].
+
+        Returns:
+            (obstacle clearance, self clearance) [m].
+        """
         q = self.robot.check_q(q)
         if self.broadphase and self.metric == "gjk":
             return self._min_broadphase(q, t)
@@ -231,11 +296,27 @@ class Scene:
         return float(np.min(d[:n], initial=np.inf)), float(np.min(d[n:], initial=np.inf))
 
     def distances_batch(self, Q: np.ndarray, t: float = 0.0) -> np.ndarray:
-        """distances() for each row of Q: an array (configurations, links, obstacles)."""
+        """distances() for each row of Q: an array (configurations, links, obstacles).
+
+        Args:
+            Q: joint configurations, shape (n, nq) [rad or m].
+            t: time, for the poses of moving obstacles [s].
+
+        Returns:
+            The distances, shape (n, links, obstacles) [m].
+        """
         return np.stack([self.distances(q, t) for q in self._check_batch(Q)])
 
     def min_distance_batch(self, Q: np.ndarray, t: float = 0.0) -> np.ndarray:
-        """min_distance() for each row of Q."""
+        """min_distance() for each row of Q.
+
+        Args:
+            Q: joint configurations, shape (n, nq) [rad or m].
+            t: time, for the poses of moving obstacles [s].
+
+        Returns:
+            The clearances, shape (n,) [m].
+        """
         return np.array([self.min_distance(q, t) for q in self._check_batch(Q)])
 
     # ----- internals ---------------------------------------------------------------------------
@@ -260,92 +341,6 @@ class Scene:
         self._move_obstacles(t)
         pin.updateGeometryPlacements(self.robot.model, self.robot.data, self._geo.exact,
                                      self._exact_data, q)  # fmt: skip
-
-    def _exact(self, p: int) -> float:
-        """Signed distance of pair p at the current placements, independent of earlier calls.
-
-        coal warm-starts GJK from the previous answer of the same pair; resetting the guess
-        makes every answer a function of the placements alone, so the broad phase and the
-        full loop give bit-identical numbers.
-        """
-        request = self._requests[p]
-        request.cached_support_func_guess = _NO_SUPPORT_GUESS
-        request.cached_gjk_guess = _NO_GJK_GUESS
-        pin.computeDistance(self._geo.exact, self._exact_data, p)
-        return self._results[p].min_distance
-
-    def _pair_distances(
-        self, q: np.ndarray, t: float, every_pair: bool = False, within: float = np.inf
-    ) -> list[float]:
-        """Distance of every pair; with the broad phase, pairs that cannot be the minimum of
-        their cell are left at +inf unless `every_pair`, and with `every_pair` those whose
-        lower bound is `within` [m] or more."""
-        n = len(self._cell_of_pair)
-        if self.metric == "vertex":
-            self._place(q, t)
-            return [self._vertex_distance(p) for p in range(n)]
-        if every_pair and self.broadphase and within < np.inf:
-            lower = self._lower_bounds(q, t)
-            pin.updateGeometryPlacements(self.robot.model, self.robot.data, self._geo.exact,
-                                         self._exact_data)  # fmt: skip
-            return [self._exact(p) if lower[p] < within else np.inf for p in range(n)]
-        if every_pair or not self.broadphase:
-            self._place(q, t)
-            return [self._exact(p) for p in range(n)]
-        lower = self._lower_bounds(q, t)
-        pin.updateGeometryPlacements(self.robot.model, self.robot.data, self._geo.exact,
-                                     self._exact_data)  # fmt: skip
-        out = [np.inf] * n
-        cell_best: dict[tuple[int, int], float] = {}
-        for p in sorted(range(n), key=lower.__getitem__):
-            cell = self._cell_of_pair[p]
-            if lower[p] >= cell_best.get(cell, np.inf):
-                continue
-            out[p] = self._exact(p)
-            cell_best[cell] = min(cell_best.get(cell, np.inf), out[p])
-        return out
-
-    def _lower_bounds(self, q: np.ndarray, t: float) -> list[float]:
-        """Capsule-capsule distances of every pair (lower bounds of the exact ones; -inf for the
-        static pairs, which the bounds model skips); also runs the forward kinematics that the
-        exact placements then reuse."""
-        self._move_obstacles(t)
-        pin.computeDistances(self.robot.model, self.robot.data, self._geo.bounds,
-                             self._bounds_data, q)  # fmt: skip
-        lower = [-np.inf] * len(self._bound_results)  # static pairs: no bound, always exact
-        for p, r in zip(self._dynamic, self._dynamic_bounds, strict=True):
-            lower[p] = r.min_distance
-        return lower
-
-    def _min_broadphase(self, q: np.ndarray, t: float) -> tuple[float, float]:
-        # The hot path of the planner: attribute lookups are hoisted, _exact is inlined.
-        if self._moving:
-            self._move_obstacles(t)
-        model, data = self.robot.model, self.robot.data
-        pin.computeDistances(model, data, self._geo.bounds, self._bounds_data, q)
-        lower = [r.min_distance for r in self._dynamic_bounds]
-        exact_model, exact_data = self._geo.exact, self._exact_data
-        pin.updateGeometryPlacements(model, data, exact_model, exact_data)
-        requests, results, dynamic = self._requests, self._results, self._dynamic
-        best = list(self._static_min)  # [obstacles, self]
-        kinds, present = self._dynamic_kinds, self._kinds_present
-        # Visit pairs by increasing lower bound; none after the first bound above the best
-        # exact distance so far of every kind can lower a minimum.
-        for i in sorted(range(len(lower)), key=lower.__getitem__):
-            kind = kinds[i]
-            if lower[i] >= best[kind]:
-                if all(lower[i] >= best[k] for k in present):
-                    break
-                continue
-            p = dynamic[i]
-            request = requests[p]
-            request.cached_support_func_guess = _NO_SUPPORT_GUESS  # as in _exact
-            request.cached_gjk_guess = _NO_GJK_GUESS
-            pin.computeDistance(exact_model, exact_data, p)
-            d = results[p].min_distance
-            if d < best[kind]:
-                best[kind] = d
-        return float(best[0]), float(best[1])
 
     def _cell_minima(self, pair_distances: list[float]) -> np.ndarray:
         out = np.full(self._shape, np.inf)

@@ -27,7 +27,13 @@ MARGIN = 0.02  # [m] a pair that never comes closer than this over the samples i
 
 @dataclass(frozen=True)
 class SelfCollisionMatrix:
-    """The link pairs to check, and each skipped pair with why it was skipped."""
+    """The link pairs to check, and each skipped pair with why it was skipped.
+
+    Attributes:
+        checked: the link pairs (a, b) by name whose distance a self-collision check takes.
+        skipped: every other pair, with its reason: "adjacent", "never close",
+            "always touching" or "allowed".
+    """
 
     checked: tuple[tuple[str, str], ...]
     skipped: dict[tuple[str, str], Reason]

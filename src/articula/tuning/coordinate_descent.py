@@ -18,6 +18,13 @@ class DescentStep:
     """The state after one sweep over all coordinates (one `count` of Algorithm 1).
 
     k and dk are stored as read-only copies.
+
+    Attributes:
+        count: number of sweeps done (0 = the random start).
+        k: parameters K after this sweep, shape (p,).
+        dk: probing steps dK after this sweep, shape (p,).
+        best_cost: lowest cost M found so far.
+        evaluations: number of cost evaluations so far.
     """
 
     count: int
@@ -35,7 +42,12 @@ class DescentStep:
 class DescentResult:
     """Optimised parameters K* (read-only copy), their cost M(K*), and every sweep's state.
 
-    history[0] holds the random start, so history[0].k against k shows what moved.
+    Attributes:
+        k: optimised parameters K*, shape (p,).
+        cost: their cost M(K*).
+        evaluations: number of cost evaluations made (probes outside the bounds not counted).
+        history: the state after each sweep; history[0] holds the random start, so
+            history[0].k against k shows what moved.
     """
 
     k: np.ndarray
@@ -65,6 +77,18 @@ def coordinate_descent(
     as a failure without being evaluated, so that, e.g., a gain never turns negative. The
     random K and dK of the algorithm's first lines are the caller's (draw them from a seeded
     Generator), so a tuning run is reproducible.
+
+    Args:
+        cost: cost M(K) of a parameter vector, e.g. one experiment's Eq. (2.5); lower is better.
+        k0: starting parameters K, shape (p,).
+        dk0: starting probing steps dK, positive, shape (p,).
+        k_stop: threshold on |dK|_1 below which the search stops.
+        max_iterations: most sweeps over all coordinates.
+        lower: lower bounds on K, shape (p,); None for none.
+        upper: upper bounds on K, shape (p,); None for none.
+
+    Returns:
+        The optimised parameters, their cost and the state after every sweep.
     """
     k = np.array(k0, dtype=float)
     dk = np.array(dk0, dtype=float)

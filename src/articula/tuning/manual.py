@@ -26,7 +26,13 @@ from articula.validation import Positive, StrictModel, field_error
 
 
 class Ladder(StrictModel):
-    """Values tried in turn: start, start·factor, ... up to at most `stop` (a gain's unit)."""
+    """Values tried in turn: start, start·factor, ... up to at most `stop` (a gain's unit).
+
+    Attributes:
+        start: first value tried, > 0.
+        factor: ratio between successive values, in (1, 1000].
+        stop: largest value that may be tried, at least start.
+    """
 
     start: Positive
     factor: Annotated[float, Field(gt=1, le=1e3, allow_inf_nan=False)]
@@ -39,15 +45,25 @@ class Ladder(StrictModel):
         return self
 
     def values(self) -> list[float]:
-        """The rungs, smallest first."""
+        """The rungs, smallest first.
+
+        Returns:
+            The values start·factor^i that do not exceed stop.
+        """
         count = int(np.floor(np.log(self.stop / self.start) / np.log(self.factor) + 1e-9)) + 1
         return [self.start * self.factor**i for i in range(count)]
 
 
 @dataclass(frozen=True, eq=False)
 class Trial:
-    """One experiment of a tuning procedure: gains (read-only copy), response, features and
-    what was decided."""
+    """One experiment of a tuning procedure: gains, response, features and what was decided.
+
+    Attributes:
+        gains: the gains [K_p, K_i, K_d] tried (read-only copy), shape (3,).
+        response: the step response they gave.
+        features: the features of that response the procedure decided on.
+        decision: what the procedure concluded from it, in words.
+    """
 
     gains: np.ndarray
     response: Response
@@ -62,8 +78,11 @@ class Trial:
 class ManualResult:
     """Chosen gains [K_p, K_i, K_d] (read-only copy) and every experiment that led to them.
 
-    within_tolerance: False when no K_i on the ladder brought the steady-state error within
-    the tolerance (the largest K_i tried is kept, and its trial says so).
+    Attributes:
+        gains: the chosen gains [K_p, K_i, K_d], shape (3,).
+        trials: every experiment run, in order, with its decision.
+        within_tolerance: False when no K_i on the ladder brought the steady-state error
+            within the tolerance (the largest K_i tried is kept, and its trial says so).
     """
 
     gains: np.ndarray
@@ -78,7 +97,9 @@ class ManualSettings(StrictModel):
     """Ladders and tolerances of the procedure (units of the response: degrees in chapter 2).
 
     Attributes:
-        kp, ki, kd: the rungs tried for each gain.
+        kp: the rungs tried for K_p.
+        ki: the rungs tried for K_i.
+        kd: the rungs tried for K_d.
         band: the noise band about a level; swings inside it do not count.
         tolerance: the acceptable steady-state error.
     """
@@ -100,6 +121,13 @@ def manual_tuning(
     response shows an overshoot lower by more than the noise band, no more swings and a
     steady-state error still within tolerance. Raises InfeasibleError if the smallest K_p
     already gives swings that grow or persist (the procedure has no K_p to keep).
+
+    Args:
+        experiment: runs one step response with gains [K_p, K_i, K_d].
+        settings: ladders and tolerances; None for the defaults.
+
+    Returns:
+        The chosen gains and every experiment with its decision.
     """
     settings = settings or ManualSettings()
     trials: list[Trial] = []
@@ -186,7 +214,16 @@ ZIEGLER_NICHOLS: dict[str, tuple[float, float, float]] = {
 
 
 def ziegler_nichols(ku: float, tu: float, rule: ZnRule = "PID") -> np.ndarray:
-    """[K_p, K_i, K_d] from ultimate gain K_u and period T_u [s]: K_i = K_p/T_i, K_d = K_p T_d."""
+    """[K_p, K_i, K_d] from ultimate gain K_u and period T_u: K_i = K_p/T_i, K_d = K_p T_d.
+
+    Args:
+        ku: ultimate gain K_u, the P-only gain of sustained oscillation.
+        tu: ultimate period T_u of that oscillation [s].
+        rule: row of the classic Ziegler-Nichols table: "P", "PI" or "PID".
+
+    Returns:
+        The gains [K_p, K_i, K_d], shape (3,) (K_i per second, K_d times seconds).
+    """
     if rule not in ZIEGLER_NICHOLS:
         raise ConfigError("rule", f"unknown rule {rule!r}; use one of {sorted(ZIEGLER_NICHOLS)}")
     if not (ku > 0 and tu > 0 and np.isfinite(ku) and np.isfinite(tu)):
@@ -199,7 +236,19 @@ def ziegler_nichols(ku: float, tu: float, rule: ZnRule = "PID") -> np.ndarray:
 def ultimate_gain(
     experiment: GainExperiment, ladder: Ladder, band: float, sustained: float = 0.8
 ) -> tuple[float, float, list[Trial]]:
-    """(K_u, T_u, experiments): the first P-only gain whose swings keep `sustained` of size."""
+    """(K_u, T_u, experiments): the first P-only gain whose swings keep `sustained` of size.
+
+    Raises InfeasibleError if no gain on the ladder gives a sustained oscillation.
+
+    Args:
+        experiment: runs one step response with gains [K_p, K_i, K_d].
+        ladder: the K_p values tried in turn (K_i = K_d = 0).
+        band: noise band about a level; swings inside it do not count (response units).
+        sustained: fraction of the first swings' size the last swings must keep.
+
+    Returns:
+        The ultimate gain K_u, the ultimate period T_u [s], and every experiment run.
+    """
     trials: list[Trial] = []
     for kp in ladder.values():
         gains = np.array([kp, 0.0, 0.0])

@@ -13,7 +13,14 @@ import numpy as np
 
 
 def readonly(values: np.ndarray | float | list[float]) -> np.ndarray:
-    """A read-only float copy, for arrays held by frozen dataclasses."""
+    """A read-only float copy, for arrays held by frozen dataclasses.
+
+    Args:
+        values: a number or an array-like of numbers.
+
+    Returns:
+        A float array copy of `values` with its write flag off.
+    """
     array = np.array(values, dtype=float)
     array.setflags(write=False)
     return array
@@ -24,6 +31,11 @@ class Response:
     """Sample times [s], reference and measured output (same unit, e.g. degrees), all (n,).
 
     The arrays are stored as read-only copies.
+
+    Attributes:
+        t: sample times, shape (n,) [s].
+        reference: reference θ_r at each sample, shape (n,).
+        measured: measured output θ at each sample, shape (n,), in the reference's unit.
     """
 
     t: np.ndarray
@@ -39,7 +51,15 @@ GainExperiment = Callable[[np.ndarray], Response]
 
 
 def tracking_error(reference: np.ndarray, measured: np.ndarray) -> np.ndarray:
-    """E of Eq. (2.7) along the last axis: the mean of |θ_r[i] − θ[i]|."""
+    """E of Eq. (2.7) along the last axis: the mean of |θ_r[i] − θ[i]|.
+
+    Args:
+        reference: reference θ_r, shape (..., n).
+        measured: measured output θ, shape (..., n), in the reference's unit.
+
+    Returns:
+        The mean absolute tracking error, shape (...), in the reference's unit.
+    """
     return np.mean(np.abs(reference - measured), axis=-1)  # Eq. (2.7)
 
 
@@ -47,6 +67,14 @@ def tuning_cost(t: np.ndarray, reference: np.ndarray, measured: np.ndarray) -> n
     """M of Eq. (2.5) along the last axis: the mean of |e[i]| + |Δe_i/Δt_i|.
 
     The first sample has no previous one, so its Δe/Δt is taken as 0 (as in the PID).
+
+    Args:
+        t: sample times, shape (n,) [s].
+        reference: reference θ_r, shape (..., n).
+        measured: measured output θ, shape (..., n), in the reference's unit.
+
+    Returns:
+        The cost M, shape (...).
     """
     e = reference - measured
     slope = np.zeros_like(e)
@@ -56,7 +84,15 @@ def tuning_cost(t: np.ndarray, reference: np.ndarray, measured: np.ndarray) -> n
 
 @dataclass(frozen=True, eq=False)
 class StepFeatures:
-    """What the manual procedure looks at in a step response from rest (response units)."""
+    """What the manual procedure looks at in a step response from rest (response units).
+
+    Attributes:
+        overshoot: largest excursion past the target, >= 0.
+        steady_state_error: |target − mean output| over the last quarter of the run.
+        peak_times: times of the extremes of each swing about the final level beyond the
+            band, shape (s,) [s].
+        peak_sizes: |output − final level| at those extremes, shape (s,).
+    """
 
     overshoot: float  # largest excursion past the target (response units, >= 0)
     steady_state_error: float  # |target − mean output| over the last quarter of the run
@@ -87,6 +123,12 @@ class StepFeatures:
 
         Swings are compared in pairs (one up, one down) because a driven soft actuator swings
         further one way than the other.
+
+        Args:
+            keep: fraction of the first two swings' mean size the last two must keep.
+
+        Returns:
+            True if the oscillation is sustained.
         """
         sizes = self.peak_sizes
         return sizes.size >= 3 and float(np.mean(sizes[-2:])) >= keep * float(np.mean(sizes[:2]))
@@ -98,7 +140,15 @@ class StepFeatures:
 
 
 def step_features(response: Response, band: float) -> StepFeatures:
-    """Features of a step response from rest; `band` is the noise band about a level."""
+    """Features of a step response from rest.
+
+    Args:
+        response: the step response; its target is the reference's last value.
+        band: noise band about a level; swings inside it do not count (response units).
+
+    Returns:
+        The overshoot, steady-state error and the swings about the final level.
+    """
     target = float(response.reference[-1])
     y = response.measured
     step = target - float(y[0]) or 1.0

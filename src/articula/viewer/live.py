@@ -41,7 +41,16 @@ DRAW_EVERY = 3  # periods between pictures: 33 Hz at 10 ms, smooth to the eye (e
 @dataclass
 class Recording:
     """What happened, period by period: times [s], configurations [rad], end-effector and
-    target positions [m], clearance [m], obstacle poses (name -> [x, y, z, qw, qx, qy, qz])."""
+    target positions [m], clearance [m], obstacle poses (name -> [x, y, z, qw, qx, qy, qz]).
+
+    Attributes:
+        t: each period's planner time [s].
+        q: each period's joint positions, shape (n,) each [rad].
+        x: each period's end-effector position, shape (3,) each [m].
+        x_ref: each period's target position, shape (3,) each [m].
+        clearance: each period's smallest clearance [m] (inf without obstacles).
+        obstacles: obstacle name -> its pose each period, [x, y, z (m), qw, qx, qy, qz].
+    """
 
     t: list[float] = field(default_factory=list)
     q: list[np.ndarray] = field(default_factory=list)
@@ -54,7 +63,14 @@ class Recording:
 @dataclass
 class LiveScene:
     """A scene file read and checked for `live`: its plan config (the method given, if one
-    was), scene, start configuration [rad] and end-effector path."""
+    was), scene, start configuration [rad] and end-effector path.
+
+    Attributes:
+        config: the scene file as a plan config (its paths absolute).
+        scene: the robot and obstacles.
+        q0: the start configuration, shape (n,) [rad].
+        targets: the end-effector's path (t [s] -> target).
+    """
 
     config: dict[str, Any]
     scene: Scene
@@ -64,7 +80,15 @@ class LiveScene:
     @classmethod
     def load(cls, scene_file: Path, method: str | None = None) -> LiveScene:
         """Read scene_file; an ArticulaError (before any server opens) when its planner does
-        not validate or cannot start from its q0."""
+        not validate or cannot start from its q0.
+
+        Args:
+            scene_file: a scene TOML with [planner] and [trajectory] tables.
+            method: the planner method to use instead of the file's; None: the file's.
+
+        Returns:
+            The scene file, read and checked.
+        """
         config = _plan_config(scene_file)
         if method is not None:
             config["planner"]["method"] = method
@@ -76,7 +100,12 @@ class LiveScene:
 
 
 class Live:
-    """The live page of one scene file in one viser server."""
+    """The live page of one scene file in one viser server.
+
+    Args:
+        server: the viser server the page is served by.
+        loaded: the scene file, read and checked.
+    """
 
     def __init__(self, server: viser.ViserServer, loaded: LiveScene) -> None:
         self.server = server
@@ -124,7 +153,11 @@ class Live:
         return float(self.config["planner"].get("dt", 0.01))
 
     def spec(self) -> PlannerSpec:
-        """The planner of the scene file with the panel's method, Λ and d_min."""
+        """The planner of the scene file with the panel's method, Λ and d_min.
+
+        Returns:
+            The planner's settings.
+        """
         panel = {"method": self.method.value, "lambda_weight": float(self.lam.value),
                  "d_min": float(self.d_min.value)}  # fmt: skip
         return PlannerSpec(**(self.config["planner"] | panel))
@@ -149,7 +182,11 @@ class Live:
 
     def period(self) -> float:
         """One control period: obstacles from their gizmos, one planner step, the page
-        updated; returns the planner's time [s]."""
+        updated.
+
+        Returns:
+            The wall time the planner's step took [s].
+        """
         controller = self.controller
         assert controller is not None
         t = self.periods * self.dt
@@ -248,7 +285,15 @@ class Live:
             controller.live[name].pose = T
 
     def write(self, folder: Path, wall_time: float) -> dict[str, Any]:
-        """The recording as a run folder `articula view` replays; returns its record."""
+        """The recording as a run folder `articula view` replays.
+
+        Args:
+            folder: the run folder to write.
+            wall_time: the session's wall-clock duration, for the record [s].
+
+        Returns:
+            The run's record (record.json).
+        """
         r = self.recording
         if not r.t:
             raise ArticulaError("--record: nothing happened yet (no control period ran)")
@@ -280,7 +325,16 @@ def _plan_config(scene_file: Path) -> dict[str, Any]:
 
 def run_live(scene_file: Path, method: str | None, host: str, port: int, record: Path | None,
              announce) -> None:  # fmt: skip
-    """Serve the live page until Ctrl-C, a period every dt; then write --record if asked."""
+    """Serve the live page until Ctrl-C, a period every dt; then write --record if asked.
+
+    Args:
+        scene_file: the scene TOML to run (with [planner] and [trajectory]).
+        method: the planner method to start with; None: the scene file's.
+        host: the address to listen on.
+        port: the TCP port to listen on.
+        record: the run folder to write the session to at the end; None: none.
+        announce: called as announce(url) once the page is served.
+    """
     from articula.viewer.replay import open_server
 
     loaded = LiveScene.load(scene_file, method)  # a bad file fails before the port opens

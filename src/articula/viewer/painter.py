@@ -17,7 +17,11 @@ import viser
 
 
 class Painter:
-    """Runs `paint` callables in one `server.atomic()` batch each, newest first, on a thread."""
+    """Runs `paint` callables in one `server.atomic()` batch each, newest first, on a thread.
+
+    Args:
+        server: the viser server the pictures are pushed to.
+    """
 
     def __init__(self, server: viser.ViserServer) -> None:
         self._server = server
@@ -33,15 +37,25 @@ class Painter:
 
     def post(self, paint: Callable[[], None]) -> None:
         """Hand over the newest picture; one handed over before and not yet painted is
-        dropped."""
+        dropped.
+
+        Args:
+            paint: updates the page's scene and panel (run on the painter's thread).
+        """
         with self._lock:
             self._pending = paint
             self._idle.clear()
         self._wake.set()
 
     def flush(self, timeout: float = 5.0) -> bool:
-        """Wait up to `timeout` [s] until every picture handed over is on its way to the
-        page; returns whether it is."""
+        """Wait up to `timeout` until every picture handed over is on its way to the page.
+
+        Args:
+            timeout: the longest wait [s].
+
+        Returns:
+            Whether every picture handed over was painted in time.
+        """
         return self._idle.wait(timeout)
 
     def stop(self) -> None:

@@ -27,7 +27,12 @@ FRAME_S = 1.0 / 30.0  # [s] between frames while playing
 
 class Replay:
     """The replay of the runs in a folder, in one viser server (every browser tab sees the same
-    state)."""
+    state).
+
+    Args:
+        server: the viser server the page is served by.
+        runs: the run folders to pick from, at least one (the first is shown).
+    """
 
     def __init__(self, server: viser.ViserServer, runs: list[Path]) -> None:
         self.server = server
@@ -48,7 +53,11 @@ class Replay:
         self.load(runs[0])
 
     def load(self, folder: Path) -> None:
-        """Show the run in `folder` from its start."""
+        """Show the run in `folder` from its start.
+
+        Args:
+            folder: a planner's run folder.
+        """
         run = load_run(folder)
         self.run = run
         scene = self.server.scene
@@ -72,7 +81,11 @@ class Replay:
         self.show(0)
 
     def show(self, k: int) -> None:
-        """Put the arm, the obstacles and the closest pair at sample k."""
+        """Put the arm, the obstacles and the closest pair at sample k.
+
+        Args:
+            k: the sample's index.
+        """
         run = self.run
         assert run is not None
         self.index = k
@@ -100,7 +113,11 @@ class Replay:
         self.status.content = text
 
     def tick(self, elapsed: float) -> None:
-        """Advance by `elapsed` [s] of wall time times the speed while playing."""
+        """Advance by `elapsed` of wall time times the speed while playing.
+
+        Args:
+            elapsed: wall time since the last tick [s].
+        """
         run = self.run
         if run is None or not self.playing.value:
             return
@@ -125,7 +142,15 @@ class Replay:
 
 
 def open_server(host: str, port: int) -> viser.ViserServer:
-    """A viser server on host:port; ConfigError naming --port when it is taken."""
+    """A viser server on host:port; ConfigError naming --port when it is taken.
+
+    Args:
+        host: the address to listen on.
+        port: the TCP port to listen on.
+
+    Returns:
+        The running server.
+    """
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
         probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         try:
@@ -138,7 +163,14 @@ def open_server(host: str, port: int) -> viser.ViserServer:
 
 def serve(folder: Path, host: str, port: int, announce) -> None:
     """Serve the replay of `folder` until Ctrl-C (a normal end: it returns); announce(url)
-    once it listens."""
+    once it listens.
+
+    Args:
+        folder: a planner's run folder, or a sweep's folder of them.
+        host: the address to listen on.
+        port: the TCP port to listen on.
+        announce: called as announce(url) once the server listens.
+    """
     runs = run_folders(folder)
     load_run(runs[0])  # a bad run fails before the server starts
     server = open_server(host, port)

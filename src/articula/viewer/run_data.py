@@ -27,7 +27,15 @@ TRACK = ("x", "y", "z", "qw", "qx", "qy", "qz")  # a live run's obstacle pose co
 @dataclass(frozen=True)
 class Closest:
     """The closest link-obstacle pair at one time: names, witness points [m, world] and the
-    signed distance [m]."""
+    signed distance [m].
+
+    Attributes:
+        link: the link's name.
+        obstacle: the obstacle's name.
+        on_link: the link's closest point, world frame, shape (3,) [m].
+        on_obstacle: the obstacle's closest point, world frame, shape (3,) [m].
+        distance: their signed distance (negative: penetrating) [m].
+    """
 
     link: str
     obstacle: str
@@ -40,7 +48,23 @@ class Closest:
 class RunData:
     """What `articula view` shows of one run: the scene rebuilt from its config.toml, the
     trace's time series (t [s], q [rad], x and x_ref [m], error and clearance [m]) and the
-    links' meshes (visual where the URDF has them, else the collision hulls)."""
+    links' meshes (visual where the URDF has them, else the collision hulls).
+
+    Attributes:
+        folder: the run folder.
+        scene: the robot and obstacles, rebuilt from config.toml.
+        t: sample times, shape (N,) [s].
+        q: joint positions, shape (N, nq) [rad].
+        x: achieved end-effector positions, shape (N, 3) [m].
+        x_ref: reference end-effector positions, shape (N, 3) [m].
+        error: tracking error |x - x_ref|, shape (N,) [m].
+        clearance: smallest clearance (to obstacles and, with self-collision on, between
+            link pairs), shape (N,) [m] (inf without any).
+        visuals: link name -> its meshes and their poses in the link frame.
+        d_min: the planner's safety distance [m] (0 when the config gives none).
+        obstacle_track: obstacle name -> its recorded pose per sample, shape (N, 7): x, y, z
+            [m], qw, qx, qy, qz (a live run's dragged obstacles; empty otherwise).
+    """
 
     folder: Path
     scene: Scene
@@ -55,13 +79,27 @@ class RunData:
     obstacle_track: dict[str, np.ndarray]  # name -> (samples, 7) x, y, z, qw, qx, qy, qz (live)
 
     def link_poses(self, k: int) -> dict[str, np.ndarray]:
-        """Pose (4×4, world) of every link with something to draw, at sample k."""
+        """Pose (4×4, world) of every link with something to draw, at sample k.
+
+        Args:
+            k: the sample's index.
+
+        Returns:
+            Link name -> its pose, shape (4, 4) [m].
+        """
         poses = self.scene.robot.link_poses(self.q[k])
         return {name: poses[name] for name in self.visuals if name in poses}
 
     def obstacle_poses(self, k: int) -> dict[str, np.ndarray]:
         """Pose (4×4, world) of every obstacle at sample k: the recorded one of a live run,
-        else the scene's."""
+        else the scene's.
+
+        Args:
+            k: the sample's index.
+
+        Returns:
+            Obstacle name -> its pose, shape (4, 4) [m].
+        """
         return {o.name: self._track(o.name, k) if o.name in self.obstacle_track
                 else o.pose_at(float(self.t[k])) for o in self.scene.obstacles}  # fmt: skip
 
@@ -75,14 +113,28 @@ class RunData:
         return T
 
     def link_clearances(self, k: int) -> dict[str, float]:
-        """Each link's smallest distance [m] to any obstacle at sample k (+inf without any)."""
+        """Each link's smallest distance to any obstacle at sample k (+inf without any).
+
+        Args:
+            k: the sample's index.
+
+        Returns:
+            Link name -> its signed clearance [m].
+        """
         if not self.scene.obstacles:
             return {link.name: np.inf for link in self.scene.robot.links}
         d = self._scene_at(k).distances(self.q[k], float(self.t[k]))
         return {link.name: float(d[i].min()) for i, link in enumerate(self.scene.robot.links)}
 
     def closest(self, k: int) -> Closest | None:
-        """The closest link-obstacle pair at sample k, None without obstacles."""
+        """The closest link-obstacle pair at sample k, None without obstacles.
+
+        Args:
+            k: the sample's index.
+
+        Returns:
+            The pair with its witness points and distance; None when the scene has no obstacle.
+        """
         if not self.scene.obstacles:
             return None
         w = self._scene_at(k).witnesses(self.q[k], float(self.t[k]))
@@ -107,7 +159,14 @@ class RunFolderError(ConfigError):
 
 def run_folders(folder: Path) -> list[Path]:
     """The planner runs in `folder`: itself when it is one, else a sweep's run folders that are
-    (sorted); RunFolderError when there is none."""
+    (sorted); RunFolderError when there is none.
+
+    Args:
+        folder: a run folder, or a sweep's folder of them.
+
+    Returns:
+        The run folders to show, at least one.
+    """
     if not folder.is_dir():
         raise RunFolderError("RUN_DIR", f"{folder} is not a folder")
     if (folder / CONFIG).is_file() or (folder / TRACE).is_file():
@@ -131,7 +190,14 @@ def _is_plan(folder: Path) -> bool:
 
 
 def load_run(folder: Path) -> RunData:
-    """The run in `folder`; RunFolderError naming what is missing."""
+    """The run in `folder`; RunFolderError naming what is missing.
+
+    Args:
+        folder: a planner's run folder (config.toml and trace.parquet).
+
+    Returns:
+        The run's scene, time series and link meshes.
+    """
     try:
         config = tomllib.loads((folder / CONFIG).read_text())
     except FileNotFoundError:
@@ -163,7 +229,15 @@ def load_run(folder: Path) -> RunData:
 
 def visuals_of(robot: dict, scene: Scene) -> dict[str, list[Visual]]:
     """The URDF's visual meshes of the scene's links, or their collision hulls when the URDF
-    has none or they cannot be read."""
+    has none or they cannot be read.
+
+    Args:
+        robot: the config's [robot] table (builtin, or urdf and package_dirs).
+        scene: the scene built from that config.
+
+    Returns:
+        Link name -> its meshes and their poses in the link frame.
+    """
     if "builtin" in robot:
         relative = BUILTIN[robot["builtin"]][0]
         urdf = Path(str(resources.files("articula.robots") / "data" / relative))

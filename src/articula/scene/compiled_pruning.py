@@ -1,0 +1,53 @@
+"""Pruning over a box of joint angles, compiled: the pairs that can hold the smallest
+link-obstacle distance anywhere in the box (CompiledClearance.near_pairs)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from articula.numba_cache import jit
+from articula.scene.compiled_poses import _apply, _capsule_gaps, _joint_poses, _shape_poses
+
+
+@jit()
+def _pair_bounds(
+    q, parents, joint_rot, joint_p, axes, q_index, vertices, starts, radii, shape_joint,
+    shape_rot, shape_p, capsule_a, capsule_b, capsule_r, pairs,
+):  # fmt: skip
+    """(lower, upper) bounds of every pair's distance at q: its capsules' gap, and the gap
+    between the balls of radius r around one core point of each shape."""
+    oR, op = _joint_poses(q, parents, joint_rot, joint_p, axes, q_index)
+    world_R, world_p, ends = _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a,
+                                          capsule_b, pairs)  # fmt: skip
+    upper = np.empty(pairs.shape[0])
+    point_a = np.empty(3)
+    point_b = np.empty(3)
+    for k in range(pairs.shape[0]):
+        a, b = pairs[k, 0], pairs[k, 1]
+        _apply(world_R[a], world_p[a], vertices[starts[a]], point_a)
+        _apply(world_R[b], world_p[b], vertices[starts[b]], point_b)
+        gap = point_a - point_b
+        upper[k] = math.sqrt(gap @ gap) - radii[a] - radii[b]
+    return _capsule_gaps(ends, capsule_r, pairs), upper
+
+
+@jit()
+def _near_pairs(
+    lower, upper, reach, static_min, parents, joint_rot, joint_p, axes, q_index, vertices,
+    starts, radii, shape_joint, shape_rot, shape_p, capsule_a, capsule_b, capsule_r, pairs,
+):  # fmt: skip
+    """CompiledClearance.near_pairs in one compiled call (it runs once per control period)."""
+    centre = (lower + upper) / 2.0
+    delta = reach * np.sum(upper - lower) / 2.0
+    below, above = _pair_bounds(centre, parents, joint_rot, joint_p, axes, q_index, vertices,
+                                starts, radii, shape_joint, shape_rot, shape_p, capsule_a,
+                                capsule_b, capsule_r, pairs)  # fmt: skip
+    ceiling = static_min
+    for k in range(pairs.shape[0]):
+        if pairs[k, 3] == 0 and above[k] < ceiling:
+            ceiling = above[k]
+    ceiling += 2.0 * delta
+    keep = np.array([pairs[k, 3] != 0 or below[k] <= ceiling for k in range(pairs.shape[0])])
+    return pairs[keep]

@@ -1,0 +1,67 @@
+"""The command line speaks to users: --version, a top-level help that says what articula is
+and shows its most common commands, an example in every command's help, types in words."""
+
+from __future__ import annotations
+
+import importlib.metadata
+import re
+
+import pytest
+import typer
+
+from articula.cli import _command, app, main
+
+
+def run(capsys, *argv: str) -> str:
+    """What `articula ARGV` prints on stdout (it must end with status 0)."""
+    try:
+        main(list(argv))
+    except SystemExit as exit_:
+        assert exit_.code == 0
+    return capsys.readouterr().out
+
+
+def leaf_commands() -> list[tuple[str, ...]]:
+    """The path of every command that does work (not a group)."""
+    found = []
+
+    def walk(command, path):
+        subs = getattr(command, "commands", None)
+        if subs is None:
+            found.append(path)
+        else:
+            for name, sub in subs.items():
+                walk(sub, (*path, name))
+
+    walk(typer.main.get_command(app), ())
+    return found
+
+
+def test_version_is_the_installed_distributions(capsys):
+    assert run(capsys, "--version").strip() == f"articula {importlib.metadata.version('articula')}"
+
+
+def test_top_level_help_says_what_articula_is_and_shows_common_commands(capsys):
+    text = run(capsys, "--help")
+    assert "articulated robots" in text
+    for command in ("articula reproduce all", "articula plan", "articula run"):
+        assert command in text
+    assert "--version" in text
+
+
+@pytest.mark.parametrize("path", leaf_commands(), ids=" ".join)
+def test_every_command_help_has_an_example_and_types_in_words(capsys, path):
+    text = run(capsys, *path, "--help")
+    assert re.search(r"^\s*Example: articula " + " ".join(path), text, re.M), text
+    assert not re.search(r"<(bool|str|int|float|path)[^>]*>", text), text
+    assert "--json <" not in text and "--help <" not in text
+
+
+def test_a_flag_shows_no_type_and_a_value_a_word(capsys):
+    text = run(capsys, "plan", "--help")
+    assert re.search(r"^\s*--json\s+Print one JSON object", text, re.M), text
+    assert re.search(r"^\s*--out FOLDER\s", text, re.M), text
+
+
+def test_the_click_command_is_built_once_per_call():
+    assert _command() is not _command()
