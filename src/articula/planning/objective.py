@@ -13,6 +13,11 @@ from articula.planning.task import Target, Task, as_target, target_arrays
 from articula.scene.compiled_clearance import CompiledClearance
 from articula.scene.scene import Scene
 
+# Ω's floor on self clearance [m]. The compiled GJK and coal's GJK/EPA agree to about 1e-6 m
+# away from contact but not at it: a step the one finds 1 µm clear the other may find touching.
+# A planner that rides the boundary (d_min = 0) must stay clear by either, so by this margin.
+SELF_CONTACT_MARGIN = 1e-4
+
 Box = tuple[np.ndarray, np.ndarray]  # (lower, upper) of the configurations allowed [rad]
 
 
@@ -173,7 +178,7 @@ class Objective:
         if self.compiled is not None:
             self.compiled.at(t)
             d, d_self, ee, ee_R = self.compiled.evaluate(clipped, self.needs_obstacles)
-            if d <= self.d_min or d_self <= 0:  # Ω: d > d_min (1.12); 0 on overlap
+            if d <= self.d_min or d_self <= SELF_CONTACT_MARGIN:  # Ω: d > d_min (1.12), self clear
                 return q_current, g_current
             return clipped, self._combine(self._task_error(target, ee, ee_R), d)
         if not (self.needs_obstacles or self.scene.self_pairs):
@@ -181,7 +186,7 @@ class Objective:
         d, d_self = self.scene.clearances(clipped, t)  # also leaves the joint placements updated
         if not self.needs_obstacles:
             d = np.inf
-        if d <= self.d_min or d_self <= 0:  # Ω is d > d_min (1.12), and clear of itself
+        if d <= self.d_min or d_self <= SELF_CONTACT_MARGIN:  # Ω: d > d_min (1.12), self clear
             return q_current, g_current
         return clipped, self._value(clipped, target, d, kinematics_done=True)
 
