@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import importlib.metadata
 import re
+from pathlib import Path
 
 import pytest
 import typer
@@ -65,3 +66,13 @@ def test_a_flag_shows_no_type_and_a_value_a_word(capsys):
 
 def test_the_click_command_is_built_once_per_call():
     assert _command() is not _command()
+
+
+def test_live_record_into_a_foreign_folder_names_record_and_force(main_fails, tmp_path):
+    folder = tmp_path / "notes"
+    folder.mkdir()
+    (folder / "mine.txt").write_text("a user's file")
+    scene = Path(__file__).resolve().parents[2] / "src/articula/book/ch1/configs/two_obstacles.toml"
+    line = main_fails("live", scene, "--record", folder)
+    assert "--record" in line and "--force" in line, line
+    assert (folder / "mine.txt").read_text() == "a user's file"

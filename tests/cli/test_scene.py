@@ -296,3 +296,12 @@ def test_a_bad_q_file_is_one_line_naming_the_option(main_fails, tmp_path, conten
     path.write_text(content)
     line = main_fails("scene", "check", TWO_OBSTACLES, "--q-file", path, "--json")
     assert all(w in line for w in words), line
+
+
+def test_the_table_of_many_configurations_names_every_column(cli, tmp_path):
+    csv = tmp_path / "q.csv"
+    csv.write_text("q_1,q_2,q_3,q_4,q_5,q_6,q_7\n0,0.5,0,-1,0,0.6,0\n")
+    proc = cli("scene", "check", TWO_OBSTACLES, "--q-file", csv, env={"COLUMNS": "200"})
+    assert proc.returncode == 0, proc.stderr
+    for header in ("row", "min clearance [m]", "self clearance [m]"):
+        assert header in proc.stdout, proc.stdout

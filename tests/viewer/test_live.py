@@ -128,3 +128,9 @@ def test_a_bad_scene_is_one_line_and_exit_2_before_any_server_opens(
     assert proc.returncode == 2
     assert len(proc.stderr.strip().splitlines()) == 1 and field in proc.stderr
     assert "viser" not in proc.stdout + proc.stderr  # no server was opened
+
+
+def test_the_readout_goes_out_with_a_picture():
+    from articula.viewer.live import DRAW_EVERY, READOUT_EVERY
+
+    assert READOUT_EVERY % DRAW_EVERY == 0  # else it shows only every lcm(...) periods

@@ -91,13 +91,14 @@ def _finite(obj: Any) -> Any:
     return obj
 
 
-def print_table(title: str, columns: tuple[str, str], rows: list[tuple[str, str]]) -> None:
-    """A two-column table on stdout, values right-aligned."""
+def print_table(title: str, columns: tuple[str, ...], rows: list[tuple[str, ...]]) -> None:
+    """A table on stdout: names in the first column, values right-aligned in the others."""
     from rich.markup import escape  # "[m]" is a unit, not rich markup
 
     table = Table(title=escape(title))
     table.add_column(escape(columns[0]))
-    table.add_column(escape(columns[1]), justify="right")
+    for column in columns[1:]:
+        table.add_column(escape(column), justify="right")
     for row in rows:
         table.add_row(*(escape(cell) for cell in row))
     out.print(table)

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from articula.cli.app import app, out
+from articula.cli.app import Force, app, out
 
 Port = Annotated[int, typer.Option(min=1, max=65535, help="TCP port to serve on.")]
 Host = Annotated[str, typer.Option(help="Address to listen on (0.0.0.0: every interface).")]
@@ -40,8 +40,10 @@ def live(
     port: Port = 8080,
     host: Host = "127.0.0.1",
     record: Annotated[
-        Path | None, typer.Option(help="Write what happened as a run folder `view` replays.")
+        Path | None,
+        typer.Option(metavar="FOLDER", help="Write what happened as a run folder `view` replays."),
     ] = None,
+    force: Force = False,
 ) -> None:
     """Run the scene's planner in real time in the browser; drag obstacles and the target.
 
@@ -56,6 +58,6 @@ def live(
             "--method", f"unknown method {method!r}; choose one of {', '.join(METHODS)}"
         )
     if record is not None:
-        check_out(record, "run")
+        check_out(record, "run", force, option="--record")
     run_live(scene, method, host, port, record,
              lambda url: out.print(f"live at {url} (Ctrl-C stops it)"))  # fmt: skip

@@ -86,21 +86,22 @@ def foreign_entries(folder: Path, kind: Kind) -> list[str]:
     return foreign
 
 
-def check_out(folder: Path, kind: Kind, force: bool = False) -> None:
+def check_out(folder: Path, kind: Kind, force: bool = False, option: str = "--out") -> None:
     """ConfigError unless `folder` can take articula's output: absent (with a creatable
     path), an empty folder, or one articula wrote (`force` accepts any folder).
 
     Args:
-        folder: the output folder (--out).
+        folder: the output folder.
         kind: what articula writes there: "run", "sweep", "report" or "suite".
         force: accept a folder holding files articula did not write.
+        option: the command-line option that named the folder, for the message.
     """
     if folder.exists() and not folder.is_dir():
-        raise ConfigError("--out", f"{_shown(folder)} is a file; give a folder path")
+        raise ConfigError(option, f"{_shown(folder)} is a file; give a folder path")
     if not folder.exists():
         parent = next((p for p in folder.parents if p.exists()), None)
         if parent is not None and not parent.is_dir():
-            raise ConfigError("--out", f"{_shown(parent)} is a file, so {_shown(folder)} cannot "
+            raise ConfigError(option, f"{_shown(parent)} is a file, so {_shown(folder)} cannot "
                                        "be created; give a folder path")  # fmt: skip
         return
     if force:
@@ -111,7 +112,7 @@ def check_out(folder: Path, kind: Kind, force: bool = False) -> None:
             " ..." if len(foreign) > 3 else ""
         )
         raise ConfigError(
-            "--out",
+            option,
             f"{_shown(folder)} holds files articula did not write ({shown}); give a new or "
             "empty folder, or pass --force to write into it (only articula's own files are "
             "replaced)",

@@ -33,7 +33,8 @@ from articula.viewer.painter import Painter
 from articula.viewer.run_data import PLAN, TRACK, visuals_of
 
 METHODS = ("baornn", "baornn-improved", "pinv", "dls", "qp")
-READOUT_EVERY = 10  # periods between readout updates (a person reads at most ~10 a second)
+READOUT_EVERY = 9  # periods between readouts (~10 a second, what a person reads); a
+# multiple of DRAW_EVERY, as a readout goes out with a picture
 DRAW_EVERY = 3  # periods between pictures: 33 Hz at 10 ms, smooth to the eye (each is
 # pushed to the page by the painter's thread, viewer/painter.py: the loop never waits on it)
 
