@@ -42,7 +42,12 @@ CORES = os.cpu_count() or 1  # default number of local worker processes
 MAX_WORKERS = 1024  # more would only queue
 Workers = Annotated[
     int,
-    typer.Option(min=1, max=MAX_WORKERS, help="Local worker processes (default: one per core)."),
+    typer.Option(
+        min=1,
+        max=MAX_WORKERS,
+        show_default=False,
+        help="Local worker processes (default: one per core).",
+    ),
 ]
 Force = Annotated[
     bool,

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
@@ -79,12 +79,20 @@ def motor_analyze(
         emit_json(result)
         return
     ss = result["steady_state"]
-    out.print(f"A = {result['A']}\nB = {result['B']}\npoles = {result['poles']}")
+    out.print(f"A = {_numbers(result['A'])}\nB = {_numbers(result['B'])}\n"
+              f"poles = {_numbers(result['poles'])}")  # fmt: skip
     for k, tf in result["transfer"].items():
-        out.print(f"{k:>13}: num {tf['num']}  den {tf['den']}")
+        out.print(f"{k:>13}: num {_numbers(tf['num'])}  den {_numbers(tf['den'])}")
     out.print(f"steady state at V={voltage} V, τ_ex={torque} N·m: "
               f"ω = {ss['omega']:.6g} rad/s, i = {ss['i']:.6g} A")  # fmt: skip
     if result["omega_c"] is None:
         out.print(f"ω_c: none ({result['omega_c_note']})")
     else:
         out.print(f"ω_c at V={voltage} V, i={current} A: {result['omega_c']:.6g} rad/s")
+
+
+def _numbers(values: Any) -> str:
+    """A nested list of numbers to six significant digits (no float noise like 4.4849999)."""
+    if isinstance(values, list | tuple):
+        return "[" + ", ".join(_numbers(v) for v in values) + "]"
+    return f"{values:.6g}"
