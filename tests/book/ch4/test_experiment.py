@@ -66,6 +66,21 @@ def test_config_with_empty_steady_window_is_rejected(reference: dict):
         parse_model(CurrentControlConfig, fields)
 
 
+@pytest.mark.parametrize(
+    ("fields", "field"),
+    [
+        ({"duration": 2.0, "settle": 2.0}, "settle"),
+        ({"duration": 2.0, "settle": 1.9995}, "settle"),
+        ({"duration": 2.0, "settle": 1.0, "reference": {"current": 2.0}}, "reference"),
+        ({"duration": 1.2, "settle": 1.0, "reference": {"amplitude": 0.1, "frequency": 5.0}},
+         "duration"),
+    ],
+)  # fmt: skip
+def test_a_check_across_fields_names_its_field_in_the_file(fields: dict, field: str):
+    with pytest.raises(ConfigError, match=rf"^m\.toml: {field}: "):
+        parse_model(CurrentControlConfig, fields, "m.toml")
+
+
 def test_zero_step_has_no_rise_time():
     cfg = config(duration=0.5, settle=0.3, reference={"current": 0.0, "speed": 5.0})
     _, m = simulate_batch(cfg, 1)

@@ -12,7 +12,7 @@ from articula.plants.dc_motor import PRESETS, MotorParams, feedforward_voltage
 from articula.plants.motor_rig import discretize, rig_matrices
 from articula.plants.motor_sensors import CurrentSensorParams, EncoderParams
 from articula.runs.registry import Experiment, Progress, Result
-from articula.validation import Finite, NonNegative, Positive, Seed, StrictModel
+from articula.validation import Finite, NonNegative, Positive, Seed, StrictModel, field_error
 
 MAX_STEPS = 10_000_000
 MIN_STEADY_SAMPLES = 10
@@ -69,32 +69,37 @@ class CurrentControlConfig(StrictModel):
     @model_validator(mode="after")
     def _check_times(self) -> CurrentControlConfig:
         if self.settle >= self.duration:
-            raise ValueError(
-                f"settle ({self.settle} s) must be shorter than duration ({self.duration} s)"
+            raise field_error(
+                "settle", f"{self.settle} s must be shorter than duration ({self.duration} s)"
             )
         if self.duration / self.dt > MAX_STEPS:
-            raise ValueError(f"duration/dt is over {MAX_STEPS} steps; shorten duration or raise dt")
+            raise field_error(
+                "duration", f"duration/dt is over {MAX_STEPS} steps; shorten duration or raise dt"
+            )
         t = np.arange(self.steps) * self.dt
         if self.steps - int(np.searchsorted(t, self.settle)) < MIN_STEADY_SAMPLES:
-            raise ValueError(
+            raise field_error(
+                "settle",
                 f"the steady-state window (duration − settle) holds fewer than "
-                f"{MIN_STEADY_SAMPLES} samples; lengthen duration or shorten settle"
+                f"{MIN_STEADY_SAMPLES} samples; lengthen duration or shorten settle",
             )
         ref = self.reference
         for extreme in (ref.current + ref.amplitude, ref.current - ref.amplitude):
             needed = feedforward_voltage(self.params, extreme, ref.speed)  # Eq. (4.13)
             if abs(needed) > self.pwm.v_max:
-                raise ValueError(
-                    f"reference: {extreme:g} A at {ref.speed:g} rad/s needs {needed:.3g} V, more "
+                raise field_error(
+                    "reference",
+                    f"{extreme:g} A at {ref.speed:g} rad/s needs {needed:.3g} V, more "
                     f"than the v_max = {self.pwm.v_max:g} V the driver gives; lower "
-                    "reference.current, amplitude or speed"
+                    "reference.current, amplitude or speed",
                 )
         if ref.amplitude > 0 and ref.frequency > 0:
             period = 2 * np.pi / ref.frequency
             if self.duration - self.settle < period:
-                raise ValueError(
+                raise field_error(
+                    "duration",
                     f"duration − settle ({self.duration - self.settle:g} s) is shorter than one "
-                    f"period of the reference ({period:.4g} s); lengthen duration"
+                    f"period of the reference ({period:.4g} s); lengthen duration",
                 )
         return self
 
