@@ -197,6 +197,7 @@ def test_killed_sweep_resumes_without_recomputing_finished_runs(
 
     summary = sweep_cli(spec, out, "--workers", "2")
     assert summary["runs"] == SLOW_RUNS
+    assert summary["skipped"] == len(finished)  # it says what it did not recompute
 
     assert set(_finished(out)) == set(hashes)
     for name, snap in before.items():

@@ -180,6 +180,7 @@ def test_a_config_for_another_rig_is_one_line_and_exit_2(emulated_pneunet, cli, 
     assert proc.returncode == 2
     assert proc.stderr.strip().splitlines() == [
         f"error: {emulated_pneunet}: a pneunet rig, not a motor rig"]  # fmt: skip
+    assert not (tmp_path / "run").exists()  # a refused run writes nothing
 
 
 @pytest.mark.parametrize("method", ["manual", "ziegler-nichols"])

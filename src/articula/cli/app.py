@@ -109,6 +109,11 @@ def print_table(title: str, columns: tuple[str, ...], rows: list[tuple[str, ...]
     out.print(table)
 
 
+def metric_rows(metrics: dict[str, float | None]) -> list[tuple[str, str]]:
+    """A record's metrics as table rows, six significant digits, — where there is none."""
+    return [(k, "—" if v is None else f"{v:.6g}") for k, v in metrics.items()]
+
+
 def progress_bar(quiet: bool) -> Progress:
     """A progress bar on stderr while work runs; none with --json or without a terminal (a
     log or a pipe would only collect its frames), and it leaves no line behind, so that an

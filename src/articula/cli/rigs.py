@@ -15,6 +15,7 @@ from articula.cli.app import (
     OutDir,
     app,
     emit_json,
+    metric_rows,
     out,
     print_table,
     progress_bar,
@@ -186,7 +187,7 @@ def run_(
     from articula.rigs.link import Link
     from articula.rigs.protocol import RigKind
     from articula.rigs.recorder import Recorder
-    from articula.runs.folders import claimed
+    from articula.runs.folders import check_out, claimed
     from articula.runs.registry import config_to_dict, parse_config, with_absolute_paths
     from articula.validation import load_toml
 
@@ -197,14 +198,16 @@ def run_(
                           f"{', '.join(RIG_RUNS)}")  # fmt: skip
     module, rig = RIG_RUNS[exp.name]
     driver = importlib.import_module(module)
-    with claimed(out_dir, "run", force), Link(port, RigKind[rig]) as link:
+    # The folder is checked before the rig is touched and made only once the rig has answered
+    # as the right kind: a refused run leaves nothing behind.
+    check_out(out_dir, "run", force)
+    with Link(port, RigKind[rig]) as link, claimed(out_dir, "run", force):
         recorder = Recorder(out_dir, config_to_dict(exp, cfg), driver.channels(link.info))
         record = recorder.capture(lambda: driver.run_on_rig(cfg, link, recorder), link.stats)
     if as_json:
         emit_json(record)
         return
-    rows = [(k, "n/a" if v is None else f"{v:.6g}") for k, v in record["metrics"].items()]
-    print_table(f"{exp.name} on {port}", ("metric", "value"), rows)
+    print_table(f"{exp.name} on {port}", ("metric", "value"), metric_rows(record["metrics"]))
     lost = record["link"]
     out.print(f"{record['samples']} samples; line: {lost['crc_errors']} damaged, "
               f"{lost['dropped']} lost, {lost['resends']} resent; in {out_dir}")  # fmt: skip
@@ -226,9 +229,10 @@ def record(
     from articula.rigs.link import Link
     from articula.rigs.recorder import Recorder
     from articula.rigs.run import run_program
-    from articula.runs.folders import claimed
+    from articula.runs.folders import check_out, claimed
 
-    with claimed(out_dir, "run", force), Link(port) as link:
+    check_out(out_dir, "run", force)
+    with Link(port) as link, claimed(out_dir, "run", force):
         channels = [c.name for c in link.info.channels]
         config = {"experiment": "rig.record", "port": port, "duration": duration, "seed": seed,
                   "rig": link.info.rig.name.lower()}  # fmt: skip
@@ -280,7 +284,7 @@ def tune(
     from articula.errors import ConfigError
     from articula.rigs.link import Link
     from articula.rigs.protocol import RigKind
-    from articula.runs.folders import TUNING, claimed
+    from articula.runs.folders import TUNING, check_out, claimed
     from articula.runs.records import atomic_write
     from articula.validation import load_toml, parse_model
 
@@ -295,7 +299,8 @@ def tune(
         ) from None
     data = load_toml(config or packaged("ch2", "tuning_quick.toml"))
     tuning = parse_model(TuningConfig, data, str(config or "tuning_quick.toml"))
-    with claimed(out_dir, "run", force), Link(port, RigKind.PNEUNET) as link:
+    check_out(out_dir, "run", force)
+    with Link(port, RigKind.PNEUNET) as link, claimed(out_dir, "run", force):
         with progress_bar(as_json) as bar:
             task = bar.add_task(f"{method}: experiments on the rig", total=None)
             result = tune_on_rig(tuning, link, method, chosen, index, lambda: bar.advance(task))

@@ -16,6 +16,7 @@ from articula.cli.app import (
     Workers,
     app,
     emit_json,
+    metric_rows,
     out,
     print_table,
     progress_bar,
@@ -44,8 +45,8 @@ def run(
     if as_json:
         emit_json(record)
         return
-    rows = [(k, "—" if v is None else f"{v:.6g}") for k, v in record["metrics"].items()]
-    print_table(f"{record['experiment']} (seed {record['seed']})", ("metric", "value"), rows)
+    title = f"{record['experiment']} (seed {record['seed']})"
+    print_table(title, ("metric", "value"), metric_rows(record["metrics"]))
     out.print(f"written to {out_dir}")
 
 
@@ -75,16 +76,24 @@ def sweep(
     check_backend(dask)
     configs = expand_sweep(load_toml(spec), spec.parent, max_runs, str(spec))
     check_out(out_dir, "sweep", force)
+    finished_before: list[int] = []  # the first progress call counts the runs found finished
+
+    def report(done: int, total: int) -> None:
+        if not finished_before:
+            finished_before.append(done)
+        bar.update(task, completed=done)
+
     with progress_bar(as_json) as bar:
         task = bar.add_task("sweep", total=len(configs))
-        table = run_sweep(
-            configs, out_dir, workers=workers, dask=dask, force=force,
-            progress=lambda done, total: bar.update(task, completed=done),
-        )  # fmt: skip
+        table = run_sweep(configs, out_dir, workers=workers, dask=dask, force=force,
+                          progress=report)  # fmt: skip
     failed = sum(error is not None for error in table.column("error").to_pylist())
-    summary = {"runs": table.num_rows, "failed": failed, "results": str(out_dir / RESULTS)}
+    skipped = finished_before[0] if finished_before else 0
+    summary = {"runs": table.num_rows, "skipped": skipped, "failed": failed,
+               "results": str(out_dir / RESULTS)}  # fmt: skip
     if as_json:
         emit_json(summary)
     else:
         note = f" ({failed} could not be done: see the error column)" if failed else ""
-        out.print(f"{summary['runs']} runs{note}; results in {summary['results']}")
+        out.print(f"{summary['runs']} runs, {summary['runs'] - skipped} computed and {skipped} "
+                  f"already finished{note}; results in {summary['results']}")  # fmt: skip
