@@ -15,6 +15,7 @@ from articula.planning.config import PlannerSpec, TrajectorySpec, make_planner, 
 from articula.planning.qp_ik import QpIk
 from articula.planning.trajectories import Circle, Waypoints
 from articula.planning.velocity_ik import VelocityIk
+from articula.validation import parse_model
 from tests.planning.helpers import CIRCLE, ROBOT, ball
 
 SCENE = ball([0.4, 0.3, 0.6], 0.1)
@@ -148,3 +149,10 @@ def test_a_run_longer_than_max_steps_is_refused_naming_how_to_raise_it():
         PlannerSpec(duration=1e9)
     assert exc.value.field == "PlannerSpec.duration" and "planner.max_steps" in exc.value.problem
     assert PlannerSpec(duration=2e4, max_steps=2_000_000).duration == 2e4
+
+
+@pytest.mark.parametrize("method", ["qp", "dls", "pinv"])
+def test_an_acceleration_limit_for_a_method_that_ignores_it_is_refused(method):
+    with pytest.raises(ConfigError, match=r"^scene\.toml: max_acceleration: only baornn"):
+        parse_model(PlannerSpec, {"method": method, "max_acceleration": 5.0}, "scene.toml")
+    parse_model(PlannerSpec, {"method": "baornn-improved", "max_acceleration": 5.0})

@@ -138,7 +138,8 @@ class PlannerSpec(StrictModel):
         limits: "velocity": the URDF's joint speed limits, scaled; "none": BAORNN moves as
             fast as the book's Algorithm 1 (the baselines' solvers always keep them).
         velocity_scale: fraction of the URDF joint speed limits, in (0, 1].
-        max_acceleration: joint acceleration limit for every joint; None: none [rad/s²].
+        max_acceleration: joint acceleration limit for every joint (baornn and
+            baornn-improved only); None: none [rad/s²].
         task: what the end effector tracks: "position", "pose" or "position+axis"; without
             an orientation or axis in the trajectory, the start's is held.
         orientation_weight: BAORNN's weight on the orientation error [m/rad].
@@ -169,7 +170,7 @@ class PlannerSpec(StrictModel):
     # Algorithm 1 does (the baselines' solvers always keep them).
     limits: Literal["velocity", "none"] = "velocity"
     velocity_scale: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 1.0
-    max_acceleration: Positive | None = None  # [rad/s²] for every joint; None: no limit
+    max_acceleration: Positive | None = None  # [rad/s²] every joint, BAORNN only; None: none
     # What the end effector tracks (beyond the book's position): the trajectory's orientation
     # or tool axis; without one given, the start's is held.
     task: TaskKind = "position"
@@ -190,6 +191,12 @@ class PlannerSpec(StrictModel):
             object.__setattr__(self, "settle", min(5.0, self.duration / 2))
         if self.settle >= self.duration:
             raise field_error("settle", f"must be shorter than duration = {self.duration} s")
+        if self.max_acceleration is not None and self.method not in ("baornn", "baornn-improved"):
+            raise field_error(
+                "max_acceleration",
+                f"only baornn and baornn-improved limit joint acceleration, not {self.method}; "
+                "remove it or choose one of them",
+            )
         return self
 
 
