@@ -134,3 +134,13 @@ def test_the_readout_goes_out_with_a_picture():
     from articula.viewer.live import DRAW_EVERY, READOUT_EVERY
 
     assert READOUT_EVERY % DRAW_EVERY == 0  # else it shows only every lcm(...) periods
+
+
+def test_a_start_in_collision_is_named_as_plan_names_it(main_fails, tmp_path):
+    config = load_toml(CONFIGS / "circle_two_obstacles.toml")
+    config["robot"] |= {"q0": [0.0, 1.9, 0.0, 2.0, 0.0, 2.0, 0.0], "self_collision": True}
+    config["obstacles"] = []
+    scene = tmp_path / "folded.toml"
+    scene.write_text(tomli_w.dumps(config))
+    line = main_fails("live", scene, "--port", "1")
+    assert line.startswith(f"error: {scene}: robot.q0: the start collides with itself"), line

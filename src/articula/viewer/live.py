@@ -27,7 +27,7 @@ from articula.runs.records import build_record, write_run
 from articula.runs.registry import Result
 from articula.scene.config import build_scene, load_scene_spec
 from articula.scene.scene import Scene
-from articula.validation import load_toml
+from articula.validation import fields_as, load_toml
 from articula.viewer import drawing
 from articula.viewer.painter import Painter
 from articula.viewer.run_data import PLAN, TRACK, visuals_of
@@ -96,7 +96,11 @@ class LiveScene:
         scene, q0 = build_scene(load_scene_spec(config), scene_file.parent)
         targets = make_targets(TrajectorySpec(**config["trajectory"]), scene_file.parent)
         spec = PlannerSpec(**config["planner"])
-        OnlineController.from_spec(scene, spec, int(spec.seed or 0), live_obstacles=True).reset(q0)
+        controller = OnlineController.from_spec(
+            scene, spec, int(spec.seed or 0), live_obstacles=True
+        )
+        with fields_as({"q0": f"{scene_file}: robot.q0"}):  # as `plan` names it
+            controller.reset(q0)
         return cls(config, scene, q0, targets)
 
 
