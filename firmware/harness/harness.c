@@ -3,8 +3,10 @@
  *
  *   harness FIRMWARE.elf [--plant] [--tick-us N] [--realtime]
  *
- * Prints "uart0 at <device path>", then runs until killed (or, with --plant, until its
- * standard input closes). The host opens that path as it would open /dev/ttyACM0.
+ * Prints "uart0 at <device path>" once the firmware's start-up (its INFO, sent unasked) has
+ * gone to the pty, then runs until killed (or, with --plant, until its standard input closes:
+ * the plant process has ended). The host opens that path as it would open /dev/ttyACM0.
+ * SIGUSR1 resets the board, as its reset button does: the firmware starts again.
  *
  * --plant: a plant process (articula's rigs/firmware.py) on the other end of standard input
  * and output. Each ADC conversion the firmware starts is one control period: the harness
@@ -24,6 +26,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <pty.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -60,6 +63,7 @@
 #define QUEUE 65536          /* bytes each way between the pty and the UART */
 #define OUT_HIGH_WATER 4096  /* the simulation waits for the host above this */
 #define VCC_MV 5000
+#define START_CYCLES 320000  /* 20 ms: the firmware's start-up, before the path is printed */
 
 struct queue {
     uint8_t data[QUEUE];
@@ -79,6 +83,7 @@ static int32_t encoder_count, encoder_target;
 static uint8_t encoder_phase; /* the pins' state in the Gray sequence 00, 10, 11, 01 */
 static avr_cycle_count_t step_cycles, entered[64];
 static uint8_t step_vector[64];
+static volatile sig_atomic_t reset_pressed; /* SIGUSR1: reset the board */
 
 static uint32_t queue_size(const struct queue *q) { return q->head - q->tail; }
 
@@ -112,9 +117,18 @@ static void uart_xoff(avr_irq_t *irq, uint32_t value, void *param) {
     xon = !value;
 }
 
+/* With --plant: end when the plant process has (its end of standard input closed), as
+ * reading the plant's answer does during a run. */
+static void exit_without_plant(void) {
+    struct pollfd input = {STDIN_FILENO, 0, 0};
+    if (plant && poll(&input, 1, 0) > 0 && (input.revents & (POLLHUP | POLLERR | POLLNVAL)))
+        exit(0);
+}
+
 /* Move bytes between the pty and the UART; wait for the host when it lags far behind. */
 static avr_cycle_count_t serve_pty(avr_t *a, avr_cycle_count_t when, void *param) {
     (void)a, (void)param;
+    if (!running) exit_without_plant(); /* in a run, the plant's next answer tells */
     for (;;) {
         if (QUEUE - queue_size(&to_avr) >= 4096) {
             uint8_t buffer[4096];
@@ -132,6 +146,7 @@ static avr_cycle_count_t serve_pty(avr_t *a, avr_cycle_count_t when, void *param
         if (queue_size(&to_host) <= OUT_HIGH_WATER) break;
         struct pollfd waiting = {master, POLLOUT, 0};
         poll(&waiting, 1, 100);
+        exit_without_plant();
     }
     if (queue_size(&to_avr) && !avr_cycle_timer_status(avr, uart_feed, NULL))
         avr_cycle_timer_register(avr, BYTE_CYCLES, uart_feed, NULL);
@@ -252,6 +267,25 @@ static void probe(avr_t *a, avr_io_addr_t addr, uint8_t v, void *param) {
     }
 }
 
+static void press_reset(int signal) {
+    (void)signal;
+    reset_pressed = 1;
+}
+
+/* The board's reset: the firmware starts again from its reset vector with its I/O registers
+ * cleared (simavr's avr_reset); a run going on ends there. simavr drops every cycle timer,
+ * the harness's own too, so the pty's is registered again. */
+static void reset_board(void) {
+    reset_pressed = 0;
+    avr_reset(avr);
+    if (running && plant) printf("end\n"), fflush(stdout);
+    running = 0;
+    xon = 1;
+    encoder_target = encoder_count;
+    to_sensor_rx.tail = to_sensor_rx.head;
+    avr_cycle_timer_register(avr, POLL_CYCLES, serve_pty, NULL);
+}
+
 static uint64_t wall_ns(void) {
     struct timespec now;
     clock_gettime(CLOCK_MONOTONIC, &now);
@@ -333,10 +367,20 @@ int main(int argc, char **argv) {
     fcntl(master, F_SETFL, fcntl(master, F_GETFL) | O_NONBLOCK);
     /* The slave stays open here, so the line does not hang up between a host's sessions. */
     avr_cycle_timer_register(avr, POLL_CYCLES, serve_pty, NULL);
-    printf("uart0 at %s\n", path);
-    fflush(stdout);
+    struct sigaction reset = {.sa_handler = press_reset, .sa_flags = SA_RESTART};
+    sigemptyset(&reset.sa_mask);
+    sigaction(SIGUSR1, &reset, NULL);
+    /* The firmware's start-up first: its INFO is whole in the pty when a host opens it (a
+     * host that opens it mid-frame would count the frame's tail as damaged). */
+    int announced = 0;
     for (;;) {
         int state = avr_run(avr);
         if (state == cpu_Done || state == cpu_Crashed) return state == cpu_Done ? 0 : 1;
+        if (reset_pressed) reset_board();
+        if (!announced && avr->cycle >= START_CYCLES && !queue_size(&to_host)) {
+            announced = 1;
+            printf("uart0 at %s\n", path);
+            fflush(stdout);
+        }
     }
 }

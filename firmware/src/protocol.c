@@ -87,7 +87,7 @@ void send_ack(uint16_t seq) {
 }
 
 void send_error(uint16_t seq, uint8_t code, const char *text) {
-    static uint8_t body[64];
+    static uint8_t body[MAX_FRAME - 5]; /* a frame's whole body: texts go out whole */
     uint8_t n = 0;
     body[n++] = (uint8_t)(seq & 0xFF);
     body[n++] = (uint8_t)(seq >> 8);

@@ -29,7 +29,8 @@ void frame_send(uint8_t kind, const uint8_t *body, uint8_t length);
 /* Feed one received byte; returns 1 and fills *out when it completes a valid frame (a frame
  * that fails COBS or its CRC is dropped: the host sends it again). */
 uint8_t frame_receive(uint8_t byte, struct command *out);
-/* ERROR naming a command: its seq, a code and a short text. */
+/* ERROR naming a command: its seq, a code and a text (up to MAX_FRAME - 8 characters, what a
+ * frame holds; tests/firmware checks every text of firmware/src fits). */
 void send_error(uint16_t seq, uint8_t code, const char *text);
 /* ACK naming a command. */
 void send_ack(uint16_t seq);

@@ -173,6 +173,11 @@ void rig_serve(const struct rig *rig) {
     channel_count = rig->channel_count;
     rig->stop();
     sei();
+    /* A device that starts says so, unasked (docs/protocol.md, handshake step 4): a delimiter
+     * ends the frame a reset may have cut, then INFO, the first of its sequence numbers. */
+    static const uint8_t delimiter = 0;
+    uart_write(&delimiter, 1);
+    send_info(rig);
     set_sleep_mode(SLEEP_MODE_IDLE);
     struct command command;
     uint8_t byte;

@@ -28,7 +28,8 @@ struct rig {
     void (*background)(void);
 };
 
-/* Answer commands and send the runs' telemetry; never returns. */
+/* Announce the rig (INFO, unasked), then answer commands and send the runs' telemetry; never
+ * returns. */
 void rig_serve(const struct rig *rig);
 /* From the control interrupt: one sample of the run (channel_count values). */
 void rig_sample(const float *values);

@@ -3,8 +3,10 @@ simavr, through its UART behind a pty and pyserial, against the Python side."""
 
 from __future__ import annotations
 
+import re
 import struct
 import time
+from pathlib import Path
 
 import pytest
 import serial
@@ -14,10 +16,13 @@ from articula.rigs import protocol
 from articula.rigs.link import Link
 from articula.rigs.motor import FIRMWARE, MEASURED, MotorGains
 from articula.rigs.pneunet import PneuNetDevice
-from articula.rigs.protocol import PROTOCOL_VERSION, Info, Kind, RigKind
+from articula.rigs.programs import Program, Shape
+from articula.rigs.protocol import MAX_FRAME, PROTOCOL_VERSION, Info, Kind, RigKind
 from articula.rigs.run import run_program
 
 pytestmark = pytest.mark.firmware
+SOURCES = Path(__file__).resolve().parents[2] / "firmware" / "src"
+LITERAL = r'"((?:[^"\\]|\\.)*)"'
 
 
 def test_the_handshakes_are_byte_for_byte_the_python_rigs(simavr):
@@ -77,5 +82,53 @@ def test_damaged_and_overlong_frames_are_dropped_and_the_next_one_answered(simav
     while not frames and time.monotonic() < deadline:
         frames = deframer.feed(port.read(64))
     frame = protocol.decode(frames[0])
-    assert frame.kind == Kind.INFO and frame.seq == 0  # the device's first frame
+    assert frame.kind == Kind.INFO and frame.seq == 1  # the first after its start-up INFO
     port.close()
+
+
+def error_text_cap() -> int:
+    """The longest ERROR text send_error (firmware/src/protocol.c) sends whole: its body's
+    size, with protocol.h's constants, less the seq and the code."""
+    defines = dict(re.findall(r"#define (\w+) (\d+)", (SOURCES / "protocol.h").read_text()))
+    function = (SOURCES / "protocol.c").read_text().split("void send_error(", 1)[1]
+    size = re.search(r"uint8_t body\[([^]]+)\]", function.split("\n}", 1)[0]).group(1)
+    size = re.sub(r"[A-Z_]+", lambda name: defines[name.group(0)], size)
+    assert re.fullmatch(r"[\d\s()+*/-]+", size), size
+    return eval(size) - 3  # a seq (u16) and a code (u8) come first
+
+
+def error_texts() -> list[str]:
+    """Every text the firmware's ERRORs carry: send_error's literals and the settings' and
+    starts' reasons (*why), from the C sources."""
+    texts = []
+    for source in sorted(SOURCES.glob("*.c")):
+        code = source.read_text()
+        for call in re.findall(r"\bsend_error\(([^;]*)\);", code):
+            if call.rsplit(",", 1)[-1].strip() == "why":
+                continue  # a hook's reason: its *why, below
+            assert re.search(LITERAL, call), f"{source.name}: send_error({call}) without a text"
+            texts.append("".join(re.findall(LITERAL, call)))
+        for reason in re.findall(r"\*why\s*=\s*([^;]*);", code):
+            assert re.fullmatch(rf"(\s*{LITERAL})+\s*", reason), f"{source.name}: {reason}"
+            texts.append("".join(re.findall(LITERAL, reason)))
+    return [text for text in texts if text]  # not rig.c's empty default reason
+
+
+def test_every_error_text_of_the_firmware_goes_out_whole():
+    cap = error_text_cap()
+    assert cap <= MAX_FRAME - 5 - 3  # an ERROR's text within a frame (docs/protocol.md)
+    texts = error_texts()
+    assert len(texts) >= 15 and "the run ends before the vent" in texts
+    assert [text for text in texts if len(text) > cap] == []
+    assert all(text.isascii() and text.isprintable() for text in texts)
+
+
+def test_the_longest_refusals_arrive_whole(simavr):
+    side = "this firmware fills a chamber's side (a multiple of 60 deg) at the supply"
+    order = "SET_GAINS: gains must be >= 0 and the filter order 1-100 on this firmware"
+    with Link(simavr("six_chamber")) as link, pytest.raises(DeviceError) as refused:
+        link.command(Kind.SET_REFERENCE, Program(Shape.ACTUATION, (30.0, 60e3, 1.0)).encode())
+    assert str(refused.value).endswith(f": the rig refused: {side} (code 3)")
+    with Link(simavr("motor")) as link, pytest.raises(DeviceError) as refused:
+        link.command(Kind.SET_GAINS, MotorGains(filter_order=101).encode())
+    assert str(refused.value).endswith(f": the rig refused: {order} (code 3)")

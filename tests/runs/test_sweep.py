@@ -78,7 +78,7 @@ def test_expand_sweep_of_packaged_bandwidth_sweep():
         ({"base": BASE, "grid": {"duration": [1.0, float("nan")]}}, "duration"),
         ({"base": BASE, "grid": {"rig": ["dual", "quad"]}}, "rig"),
         ({"base": {**BASE, "seed": 0}, "grid": {"seed.x": [1]}}, "grid.seed.x"),
-        ({"base": BASE, "runs": [{"settle": 9.0}]}, "config"),
+        ({"base": BASE, "runs": [{"settle": 9.0}]}, "settle"),
         ({"base": {"duration": 1.0}, "grid": {"seed": [0]}}, "experiment"),
     ],
     ids=[

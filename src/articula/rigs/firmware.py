@@ -15,6 +15,7 @@ a run.
 from __future__ import annotations
 
 import contextlib
+import signal
 import subprocess
 import threading
 from pathlib import Path
@@ -139,6 +140,11 @@ class FirmwareRig:
                     self._proc.stdin.flush()
                 except (BrokenPipeError, ValueError):
                     return  # the harness is gone
+
+    def reset(self) -> None:
+        """Reset the board, as its reset button does: the firmware starts again (and says so
+        with an INFO unasked); a run going on ends."""
+        self._proc.send_signal(signal.SIGUSR1)
 
     def close(self) -> None:
         """Stop the harness (the port goes away)."""
