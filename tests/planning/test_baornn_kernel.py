@@ -3,11 +3,16 @@ loops (coal distances) step by step on the book's two-obstacle scene."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
+from articula.planning import baornn_kernel
 from articula.planning.baornn import Baornn, BaornnParams
 from articula.planning.baornn_improved import ImprovedBaornn, ImprovedParams
 from articula.planning.objective import Objective
+from articula.planning.task import as_target
+from articula.scene.config import build_scene, load_scene_spec
 from tests.planning.helpers import CIRCLE, ROBOT
 from tests.scene.helpers import book_scene
 
@@ -48,3 +53,30 @@ def test_compiled_improved_variant_follows_its_python_loop():
     for planner in planners:
         assert planner.iterations == 40
     assert np.allclose(runs[0], runs[1], atol=1e-6)
+
+
+def test_a_point_closer_to_itself_than_the_margin_is_outside_omega_on_every_path():
+    robot = {"builtin": "iiwa14", "self_collision": True}
+    scene, _ = build_scene(load_scene_spec({"robot": robot}), Path("."))
+    clear = np.array([0.0, 0.6, 0.0, -1.2, 0.0, 1.0, 0.0])
+    folded = np.array([0.0, 1.9, 0.0, 2.0, 0.0, 2.0, 0.0])  # links 5 and 7 overlap
+    lo, hi = 0.0, 1.0  # bisect to a point 20-80 µm from contact, inside the margin
+    for _ in range(60):
+        mid = (lo + hi) / 2
+        d = scene.self_clearance(clear + mid * (folded - clear))
+        if 2e-5 < d < 8e-5:
+            break
+        lo, hi = (mid, hi) if d > 0 else (lo, mid)
+    q = clear + mid * (folded - clear)
+    assert 0.0 < scene.self_clearance(q) < baornn_kernel.SELF_CONTACT_MARGIN
+    target = as_target(np.array([0.0, 0.6, 0.5]))
+    for compiled in (True, False):
+        objective = Objective(scene, 0.0, 1.0, 0.0, use_compiled=compiled)
+        kept, g = objective.project_and_value(q, clear, 7.0, target, 0.0)
+        assert np.array_equal(kept, clear) and g == 7.0
+    objective = Objective(scene, 0.0, 1.0, 0.0)
+    x_ref, orient = target.position, objective.orient_arguments(target)
+    kept, g, _ = baornn_kernel._project_and_value(
+        q, clear, 7.0, 0.5, x_ref, orient, *objective.kernel_arguments()
+    )
+    assert np.array_equal(kept, clear) and g == 7.0

@@ -14,6 +14,13 @@ from articula.numba_cache import jit
 from articula.planning.task import orientation_error
 from articula.scene.compiled_clearance import _evaluate
 
+# Ω's floor on self clearance [m] (docs/deviations.md, self-collision). The compiled GJK and
+# coal's GJK/EPA agree to about 1e-6 m away from contact but not at it: a step the one finds
+# 1 µm clear the other may find touching, so a planner that rides the boundary (d_min = 0)
+# must stay clear by this margin. Here, not in objective.py, so that numba's cache of these
+# kernels sees a change of it.
+SELF_CONTACT_MARGIN = 1e-4
+
 
 @jit()
 def _task_error(ee, ee_R, x_ref, orient):  # fmt: skip
@@ -33,12 +40,13 @@ def _project_and_value(
     arrays, static_min,
 ):  # fmt: skip
     """(P_Ω(q), g there, the task error e there), Eqs. (1.17)-(1.18); stays at (q_current,
-    g_current, e_current) unless the clipped point keeps d > d_min (1.12) and clear of itself:
-    clearance is 0 on overlap, so d_min = 0 still rejects a point inside an obstacle. The
+    g_current, e_current) unless the clipped point keeps d > d_min (1.12) and its self
+    clearance above SELF_CONTACT_MARGIN: clearance is 0 on overlap, so d_min = 0 still rejects a
+    point inside an obstacle. The
     pairs in `arrays` are the ones that count (an obstacle clearance of +inf: none)."""
     clipped = np.minimum(np.maximum(q, lower), upper)
     d, d_self, ee, ee_R = _evaluate(clipped, *arrays, static_min)
-    if d <= d_min or d_self <= 0.0:
+    if d <= d_min or d_self <= SELF_CONTACT_MARGIN:
         return q_current, g_current, e_current
     e = _task_error(ee, ee_R, x_ref, orient)  # Eq. (1.5), with the orientation term
     return clipped, _penalised(e, d, lambda_weight, beta), e

@@ -9,14 +9,10 @@ import numpy as np
 import pinocchio as pin
 
 from articula.errors import ConfigError, ModelError
+from articula.planning.baornn_kernel import SELF_CONTACT_MARGIN
 from articula.planning.task import Target, Task, as_target, target_arrays
 from articula.scene.compiled_clearance import CompiledClearance
 from articula.scene.scene import Scene
-
-# Ω's floor on self clearance [m]. The compiled GJK and coal's GJK/EPA agree to about 1e-6 m
-# away from contact but not at it: a step the one finds 1 µm clear the other may find touching.
-# A planner that rides the boundary (d_min = 0) must stay clear by either, so by this margin.
-SELF_CONTACT_MARGIN = 1e-4
 
 Box = tuple[np.ndarray, np.ndarray]  # (lower, upper) of the configurations allowed [rad]
 
