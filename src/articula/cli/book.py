@@ -92,7 +92,10 @@ def motor_analyze(
 
 
 def _numbers(values: Any) -> str:
-    """A nested list of numbers to six significant digits (no float noise like 4.4849999)."""
+    """A nested list of numbers to six significant digits (no float noise like 4.4849999); a
+    complex pole, {"re", "im"} in the JSON, as a±bj."""
     if isinstance(values, list | tuple):
         return "[" + ", ".join(_numbers(v) for v in values) + "]"
+    if isinstance(values, dict):
+        return f"{values['re']:.6g}{values['im']:+.6g}j"
     return f"{values:.6g}"

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -130,6 +131,13 @@ def test_motor_analyze_complex_poles(analyze, write_toml):
     np.testing.assert_allclose(got, want, rtol=1e-9)
     np.testing.assert_allclose(np.sort_complex(np.roots(res["transfer"]["i/V"]["den"])),
                                np.sort_complex(np.array(got)), rtol=1e-9)  # fmt: skip
+
+
+def test_motor_analyze_prints_complex_poles_as_a_plus_bj(capsys, write_toml):
+    p = {"R": 1.0, "K": 0.5, "b": 0.0, "J": 0.01, "L": 0.1}
+    main(["motor", "analyze", "--params", str(write_toml(p, "ringing.toml"))])
+    poles = next(line for line in capsys.readouterr().out.splitlines() if line.startswith("poles"))
+    assert re.fullmatch(r"poles = \[-5\+\d+\.?\d*j, -5-\d+\.?\d*j\]", poles), poles
 
 
 def test_motor_analyze_in_process_prints_only_json(capsys, one_json):
