@@ -8,7 +8,13 @@ class ArticulaError(Exception):
 
 
 class ConfigError(ArticulaError, ValueError):
-    """A configuration value is missing, unknown, of the wrong type or out of range."""
+    """A configuration value is missing, unknown, of the wrong type or out of range.
+
+    Args:
+        field: where the value is: a config key path ("planner.d_min", with the file first
+            when one is known), or a command-line option ("--out").
+        problem: what is wrong with it and how to fix it.
+    """
 
     def __init__(self, field: str, problem: str) -> None:
         self.field = field
@@ -28,7 +34,9 @@ class GeometryError(ArticulaError, ValueError):
 class InfeasibleError(ArticulaError, RuntimeError):
     """A requested operating point or plan cannot be reached within the limits.
 
-    `field`, when given, names the argument (or config key) whose value makes it infeasible.
+    Args:
+        problem: why it cannot be reached and what to change.
+        field: the argument or config key whose value makes it infeasible; None: no one value.
     """
 
     def __init__(self, problem: str, field: str | None = None) -> None:

@@ -78,6 +78,24 @@ def gjk_distance(
     final simplex, (n, a0, b0, a1, b1, a2, b2), n = 0 for none. GJK restarts from those
     vertices at the new poses (Bergen's caching): a query close to the last one converges in
     one or two iterations instead of rebuilding its simplex point by point.
+
+    Args:
+        vertices: the hull vertices of every core, stacked, shape (V, 3) [m, core frame].
+        neighbours: the hull-edge adjacency of all vertices, concatenated, shape (E,).
+        offsets: where each vertex's neighbours start in `neighbours`, shape (V + 1,).
+        hints: a start vertex per core for the support search, shape (cores,); updated.
+        a: index of core A.
+        R_a: rotation of core A, shape (3, 3).
+        p_a: position of core A, shape (3,) [m].
+        radius_a: radius swept around core A (0 for a polytope) [m].
+        b: index of core B.
+        R_b: rotation of core B, shape (3, 3).
+        p_b: position of core B, shape (3,) [m].
+        radius_b: radius swept around core B [m].
+        simplex: this pair's warm start (n, a0, b0, a1, b1, a2, b2), shape (7,); updated.
+
+    Returns:
+        The distance between the two swept shapes, 0 when they overlap [m].
     """
     return _gjk(vertices, neighbours, offsets, hints, a, R_a, p_a, radius_a, b, R_b, p_b,
                 radius_b, simplex)[0]  # fmt: skip
@@ -96,6 +114,26 @@ def gjk_witnesses(
     The points come from the final simplex: the closest point of A − B is Σ λ_i w_i with
     w_i = a_i − b_i, so Σ λ_i a_i is a closest point of core A and that minus the closest
     point of A − B one of core B; each moves by its radius along the normal to the surface.
+
+    Args:
+        vertices: the hull vertices of every core, stacked, shape (V, 3) [m, core frame].
+        neighbours: the hull-edge adjacency of all vertices, concatenated, shape (E,).
+        offsets: where each vertex's neighbours start in `neighbours`, shape (V + 1,).
+        hints: a start vertex per core for the support search, shape (cores,); updated.
+        a: index of core A.
+        R_a: rotation of core A, shape (3, 3).
+        p_a: position of core A, shape (3,) [m].
+        radius_a: radius swept around core A [m].
+        b: index of core B.
+        R_b: rotation of core B, shape (3, 3).
+        p_b: position of core B, shape (3,) [m].
+        radius_b: radius swept around core B [m].
+        simplex: this pair's warm start (n, a0, b0, a1, b1, a2, b2), shape (7,); updated.
+        on_a: written with the closest point on A's surface, shape (3,) [m, world].
+        on_b: written with the closest point on B's surface, shape (3,) [m, world].
+
+    Returns:
+        The distance between the two swept shapes, 0 when they overlap [m].
     """
     d, W, Wa, n = _gjk(vertices, neighbours, offsets, hints, a, R_a, p_a, radius_a, b, R_b,
                        p_b, radius_b, simplex)  # fmt: skip
