@@ -12,7 +12,7 @@ import pytest
 from articula.errors import ConfigError
 from articula.geometry.poses import pose
 from articula.robots import RobotModel
-from articula.robots.urdf_kinematics import CONTINUOUS_LIMIT
+from articula.robots._urdf_kinematics import CONTINUOUS_LIMIT
 from tests.robots.helpers import rot_y, rot_z, urdf_origin
 from tests.robots.test_model import hand_small_ee
 

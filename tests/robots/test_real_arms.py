@@ -22,9 +22,9 @@ from articula.geometry.shapes import convex_hull, sphere
 from articula.loops.tracking import PlanResult, track, tracking_metrics
 from articula.planning.config import PlannerSpec, TrajectorySpec, make_planner, make_trajectory
 from articula.robots import RobotModel
+from articula.robots._urdf_kinematics import CONTINUOUS_LIMIT
 from articula.robots.model import LinkGeometry
 from articula.robots.urdf_geometry import resolve_mesh_path
-from articula.robots.urdf_kinematics import CONTINUOUS_LIMIT
 from articula.scene import Obstacle, Scene
 from articula.scene.config import build_scene, load_scene_spec
 

@@ -14,8 +14,7 @@ from articula.errors import ConfigError, ModelError
 from articula.geometry.shapes import ConvexShape
 from articula.limits import MAX_ANGLE, MAX_LINKS
 from articula.native import captured_output
-from articula.robots.urdf_geometry import collision_shapes
-from articula.robots.urdf_kinematics import (
+from articula.robots._urdf_kinematics import (
     _add_tool_frame,
     _check_magnitudes,
     _check_serial,
@@ -24,6 +23,7 @@ from articula.robots.urdf_kinematics import (
     _prepare_urdf,
     _unbounded,
 )
+from articula.robots.urdf_geometry import collision_shapes
 
 BUILTIN = {"iiwa14": ("iiwa14/iiwa14.urdf", "iiwa_link_ee")}
 

@@ -21,7 +21,8 @@ import numpy as np
 import pinocchio as pin
 
 from articula.numba_cache import jit
-from articula.scene.compiled_arrays import _capsule_ends, _core, _edges, _pair_rows, _reach
+from articula.scene._compiled_arrays import _capsule_ends, _core, _edges, _pair_rows, _reach
+from articula.scene._compiled_pruning import _near_pairs
 from articula.scene.compiled_poses import (
     _ee_pose,
     _joint_poses,
@@ -32,7 +33,6 @@ from articula.scene.compiled_poses import (
     _segment_distance,
     _shape_poses,
 )
-from articula.scene.compiled_pruning import _near_pairs
 from articula.scene.gjk import gjk_distance
 from articula.scene.scene import Scene
 

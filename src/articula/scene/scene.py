@@ -22,8 +22,8 @@ from articula.errors import ConfigError
 from articula.geometry.poses import transform_points
 from articula.geometry.shapes import ConvexShape
 from articula.robots.model import RobotModel
+from articula.scene._pair_distances import _PairDistances
 from articula.scene.obstacles import Obstacle
-from articula.scene.pair_distances import _PairDistances
 from articula.scene.pairs import SelfWitnesses, Witnesses, link_pairs
 
 Metric = Literal["gjk", "vertex"]

@@ -37,6 +37,16 @@ class PlanConfig(SceneSpec):
 
     `seed` seeds the planner's randomness; when absent, `planner.seed` (the form of scene
     files), else 0. The validated config holds it once, at the top.
+
+    Attributes:
+        robot: the [robot] table: the URDF, its start configuration q0 and its options.
+        obstacles: the [[obstacles]] tables, in file order.
+        seed: seed of the planner's randomness; after validation never None (`planner.seed`
+            or 0 when absent).
+        trajectory: the [trajectory] table: the path to track (circle of Eq. 1.27,
+            rectangle, waypoints or CSV) and optionally the tool's orientation or axis.
+        planner: the [planner] table: the method, its parameters, the control period and
+            the run's duration.
     """
 
     seed: Seed | None = None
@@ -55,8 +65,21 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
     """Track the path; metrics of loops.tracking.tracking_metrics and its trace columns.
 
     Relative file paths start at the working folder (a config read from a file has them made
-    absolute by `absolute_paths`). Raises InfeasibleError for a path out of reach or tracked
-    worse than `planner.tolerance`.
+    absolute by `absolute_paths`).
+
+    Args:
+        config: the validated plan config.
+        progress: called as progress(done, total) every hundredth of the run; None: silent.
+
+    Returns:
+        The metrics of tracking_metrics (rms_error and max_error after `planner.settle` [m],
+            clearances [m], collisions, joint-limit violations, planner timings) and the
+            trace columns of trace_columns (t [s], q_1..q_m [rad], x, y, z, their references
+            x_ref, y_ref, z_ref, error and clearance [m]).
+
+    Raises:
+        InfeasibleError: the path is out of the robot's reach, or its rms_error after
+            `planner.settle` exceeds `planner.tolerance`.
     """
     base = Path.cwd()
     scene, q0 = build_scene(config, base)
@@ -79,7 +102,18 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
 
 def load_plan(path: Path) -> dict[str, Any]:
     """A scene file (or a plan folder's config.toml) as a `baornn.plan` config, its file paths
-    made absolute."""
+    made absolute.
+
+    Args:
+        path: the scene file or config.toml; its relative paths start at its folder.
+
+    Returns:
+        The config's tables as read from TOML, `experiment` set to "baornn.plan" when absent
+            and its URDF, package folders, meshes and trajectory CSV paths made absolute.
+
+    Raises:
+        ConfigError: the file names another experiment (run it with `articula run`).
+    """
     data = load_toml(path)
     name = data.setdefault("experiment", NAME)
     if name != NAME:

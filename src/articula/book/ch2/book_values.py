@@ -1,4 +1,23 @@
-"""What chapter 2 of the book shows: Tables 2.2 and 2.3, its figures and what it claims."""
+"""What chapter 2 of the book shows: Tables 2.2 and 2.3, its figures and what it claims.
+
+Attributes:
+    FREQUENCIES: the reference frequencies of Table 2.3 [Hz].
+    KINDS: the controllers: ordinary, piecewise and fuzzy PID, Eqs. (2.2)-(2.4).
+    SCHEDULED: the kinds whose gains are scheduled on θ_r.
+    METHODS: the tunings: "manual" by hand (Sect. 2.3.2.1), "auto" by Algorithm 1
+        (Sect. 2.3.2.2).
+    CONTROLLERS: the six controllers of Table 2.3, named "kind-method".
+    BOOK_TABLE_2_2: Table 2.2: method -> representative point [°] ("15", "45", "75"; and
+        "sequence", the whole range of Fig. 2.6a) -> tuned gains (K_p, K_i, K_d).
+    BOOK_TABLE_2_3: Table 2.3: controller -> (median, Q1, Q3) of E over 25 trials [°], one
+        per frequency of FREQUENCIES.
+    FIG_2_5: title of Fig. 2.5, the manual tuning's steps to 90°.
+    FIG_2_6: titles of Figs. 2.6a-d, the four coordinate-descent runs, by tuning key.
+    SINUSOID_FIGURES: reference frequency [Hz] -> (file stem, figure) of Figs. 2.7-2.9, one
+        trial per controller.
+    TRACKING_LIMIT: what the book says of the highest frequency tracked (Sect. 2.4.2.2).
+    CLAIMS: claim name -> what the book says of it (Sect. 2.4.2).
+"""
 
 from __future__ import annotations
 

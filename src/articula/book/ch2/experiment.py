@@ -28,7 +28,16 @@ MAX_SAMPLES = 20_000_000  # trials × steps: three float64 channels of this size
 
 
 class AngleReference(StrictModel):
-    """θ_r(t) in degrees: a sinusoid from rest, or steps held for equal times."""
+    """θ_r(t) in degrees: a sinusoid from rest, or steps held for equal times.
+
+    Attributes:
+        kind: "sinusoid", θ_r = offset − amplitude·cos(2πft), which starts at rest, or
+            "steps", the levels in order.
+        offset_deg: mean of the sinusoid [°].
+        amplitude_deg: amplitude of the sinusoid [°]; offset ± amplitude must lie in 0-90°.
+        frequency: frequency f of the sinusoid, as in Table 2.3 [Hz].
+        levels_deg: the step levels, in order, each held for an equal share of the run [°].
+    """
 
     kind: Literal["sinusoid", "steps"] = "sinusoid"
     offset_deg: Angle = 45.0  # sinusoid: θ_r = offset − amplitude·cos(2πft), starts at rest
@@ -51,7 +60,21 @@ class AngleReference(StrictModel):
 
 
 class ControllerConfig(StrictModel):
-    """Gain schedule of Eq. (2.4), PWM output range and optional derivative filter."""
+    """Gain schedule of Eq. (2.4), PWM output range and optional derivative filter.
+
+    Attributes:
+        name: a label, e.g. "fuzzy-auto"; reported, not interpreted.
+        schedule: how the gains vary with θ_r, Eq. (2.4): "constant" (ordinary PID),
+            "piecewise" or "fuzzy".
+        gains: rows (K_p, K_i, K_d), one per point of points_deg (one row if constant), in
+            counts/°, counts/(°·s) and counts·s/°.
+        points_deg: representative points of θ_r, increasing (Sect. 2.4.2.1) [°]; ignored
+            by a constant schedule.
+        pwm_bits: PWM resolution [bits]: the output is clipped to 0 … 2^pwm_bits − 1
+            counts (8: analogWrite's 0-255).
+        derivative_tau: time constant of a first-order filter on the error's derivative [s];
+            0: unfiltered, as in the book.
+    """
 
     name: str = "ordinary"  # a label, e.g. "fuzzy-auto"; reported, not interpreted
     schedule: Literal["constant", "piecewise", "fuzzy"] = "constant"
@@ -82,13 +105,31 @@ class ControllerConfig(StrictModel):
         return self
 
     def build(self, trials: int) -> PID:
-        """The PID this config describes, for `trials` parallel actuators."""
+        """The PID this config describes, for `trials` parallel actuators.
+
+        Args:
+            trials: number of actuators controlled at once (the batch size).
+
+        Returns:
+            The PID, from the error [°] to the PWM count, its output clipped to the PWM range.
+        """
         schedule = GainSchedule(self.schedule, np.array(self.gains), np.array(self.points_deg))
         return PID(schedule, (0.0, 2.0**self.pwm_bits - 1), self.derivative_tau, trials)
 
 
 class PneuNetPidConfig(StrictModel):
-    """`trials` runs of one controller on the PneuNet, each with its own noise seed."""
+    """`trials` runs of one controller on the PneuNet, each with its own noise seed.
+
+    Attributes:
+        seed: seed of trial 0; trial i draws its sensor noise and actuator variation from
+            seed + i.
+        trials: number of trials (the book runs 25).
+        duration: length of each trial [s].
+        settle: time before E is taken [s]; 0: every sample, as Eq. (2.7).
+        reference: the reference θ_r(t).
+        controller: the PID and its gain schedule.
+        plant: the simulated PneuNet's constants.
+    """
 
     seed: Seed = 0  # trial i draws its noise from seed + i
     trials: Annotated[int, Field(ge=1, le=MAX_TRIALS)] = 25
@@ -130,7 +171,15 @@ class PneuNetPidConfig(StrictModel):
 
 
 def reference_deg(reference: AngleReference, t: np.ndarray) -> np.ndarray:
-    """θ_r at the sample times [°]; steps: the levels in order, each for an equal share of t."""
+    """θ_r at the sample times [°]; steps: the levels in order, each for an equal share of t.
+
+    Args:
+        reference: the reference's description.
+        t: sample times, shape (n,) [s]; steps use only their number.
+
+    Returns:
+        θ_r at each sample, shape (n,) [°].
+    """
     if reference.kind == "sinusoid":
         phase = 2 * math.pi * reference.frequency * t
         return reference.offset_deg - reference.amplitude_deg * np.cos(phase)
@@ -140,7 +189,15 @@ def reference_deg(reference: AngleReference, t: np.ndarray) -> np.ndarray:
 
 
 def simulate_trials(config: PneuNetPidConfig) -> ClosedLoopTrace:
-    """Every trial of a config as one batch."""
+    """Every trial of a config as one batch.
+
+    Args:
+        config: the experiment's config.
+
+    Returns:
+        The read-only trace: t [s] and reference [°], shape (n,); measured and true angle [°]
+            and valve duty, shape (trials, n), one sample per PWM period.
+    """
     t = np.arange(config.steps) * config.plant.pwm_period
     seeds = range(config.seed, config.seed + config.trials)
     controller = config.controller.build(config.trials)
@@ -148,7 +205,17 @@ def simulate_trials(config: PneuNetPidConfig) -> ClosedLoopTrace:
 
 
 def trial_metrics(config: PneuNetPidConfig, trace: ClosedLoopTrace) -> dict[str, np.ndarray]:
-    """Per-trial E (2.7) on the sensor and on the true angle [°], and M (2.5)."""
+    """Per-trial E (2.7) on the sensor and on the true angle [°], and M (2.5).
+
+    Args:
+        config: the config the trace was run with (its `settle`).
+        trace: the trace of every trial (simulate_trials).
+
+    Returns:
+        Name -> value per trial, shape (trials,): error, E on the sensor reading [°];
+            error_true, E on the true angle [°]; cost, M (2.5) on the sensor reading (these
+            three after `settle`); saturation, the fraction of PWM periods at duty 0 or 1.
+    """
     keep = trace.t >= config.settle
     ref = trace.reference[keep]
     return {
@@ -160,7 +227,18 @@ def trial_metrics(config: PneuNetPidConfig, trace: ClosedLoopTrace) -> dict[str,
 
 
 def run_pneunet_pid(config: PneuNetPidConfig, progress: Progress | None = None) -> Result:
-    """Simulate every trial; metrics are E's median and quartiles over trials, trace is trial 0."""
+    """Simulate every trial; metrics are E's median and quartiles over trials, trace is trial 0.
+
+    Args:
+        config: the experiment's config.
+        progress: not used: the trials run as one batch.
+
+    Returns:
+        Metrics error_median_deg, error_q1_deg and error_q3_deg (E on the sensor reading,
+            over trials) and error_true_median_deg [°], cost_median (M) and
+            saturation_fraction (mean over trials); trace of trial 0: t [s], theta_ref_deg,
+            theta_meas_deg, theta_deg [°] and the valve duty (0-1).
+    """
     trace = simulate_trials(config)
     m = trial_metrics(config, trace)
     q1, median, q3 = np.percentile(m["error"], [25, 50, 75])

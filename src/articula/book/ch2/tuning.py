@@ -28,7 +28,14 @@ SEQUENCE = (15.0, 45.0, 75.0, 90.0)  # whole-range tuning sequence (Fig. 2.6a)
 
 
 class ManualConfig(StrictModel):
-    """The scripted manual procedure: one step experiment per trial, `hold` seconds long."""
+    """The scripted manual procedure: one step experiment per trial, `hold` seconds long.
+
+    Attributes:
+        seed: base of the noise seeds; the step to θ starts at seed + 100·int(θ) (manual_seed).
+        hold: length of each step experiment [s].
+        band: noise band about a level; swings inside it do not count [°].
+        tolerance: acceptable steady-state error [°].
+    """
 
     seed: Seed = 1000
     hold: Positive = 10.0  # [s]
@@ -37,7 +44,21 @@ class ManualConfig(StrictModel):
 
 
 class AutoConfig(StrictModel):
-    """Coordinate descent (Algorithm 1): random K and dK, stop on |dK|_1 < k_stop or N sweeps."""
+    """Coordinate descent (Algorithm 1): random K and dK, stop on |dK|_1 < k_stop or N sweeps.
+
+    Gains (K_p, K_i, K_d) are in counts/°, counts/(°·s) and counts·s/°.
+
+    Attributes:
+        seed: seed of each run's random K and dK (with the run's index) and base of its noise
+            seeds (auto_seed).
+        hold: time each level of the reference is held [s].
+        k_stop: the descent stops when |dK|_1 falls below it.
+        max_iterations: most sweeps N over the three gains.
+        k0_max: upper ends of the random start K ~ U(0, k0_max), (K_p, K_i, K_d).
+        dk0_max: upper ends of the random steps dK ~ U(0, dk0_max), (K_p, K_i, K_d).
+        upper: upper bounds on (K_p, K_i, K_d) (not in the book); a probe beyond them fails
+            without an experiment.
+    """
 
     seed: Seed = 2000
     hold: Positive = 4.0  # [s] per level of the reference
@@ -49,7 +70,13 @@ class AutoConfig(StrictModel):
 
 
 class TuningConfig(StrictModel):
-    """All tuning runs of the chapter."""
+    """All tuning runs of the chapter.
+
+    Attributes:
+        manual: the manual procedure (Sect. 2.3.2.1, Fig. 2.5).
+        auto: coordinate descent (Algorithm 1, Fig. 2.6).
+        plant: the simulated PneuNet's constants.
+    """
 
     manual: ManualConfig = ManualConfig()
     auto: AutoConfig = AutoConfig()
@@ -58,21 +85,46 @@ class TuningConfig(StrictModel):
 
 @dataclass(frozen=True)
 class TuningRun:
-    """One coordinate-descent run and the reference levels it tuned on [°]."""
+    """One coordinate-descent run and the reference levels it tuned on [°].
+
+    Attributes:
+        levels: the reference levels, held in order [°].
+        result: the tuned gains K*, their cost M (2.5) and the state after every sweep.
+    """
 
     levels: tuple[float, ...]
     result: DescentResult
 
 
 def step_reference(levels: tuple[float, ...], hold: float, period: float) -> np.ndarray:
-    """Levels [°] held `hold` seconds each, sampled every PWM period (reference_deg, steps)."""
+    """Levels [°] held `hold` seconds each, sampled every PWM period (reference_deg, steps).
+
+    Args:
+        levels: the levels, in order [°].
+        hold: time each level is held [s].
+        period: sample interval, the PWM period [s].
+
+    Returns:
+        θ_r at each sample, shape (len(levels)·round(hold / period),) [°].
+    """
     steps = len(levels) * round(hold / period)
     config = AngleReference(kind="steps", levels_deg=[float(v) for v in levels])
     return reference_deg(config, np.arange(steps) * period)
 
 
 def manual_run(config: TuningConfig, level: float) -> ManualResult:
-    """The manual procedure on steps from rest to `level` [°]."""
+    """The manual procedure on steps from rest to `level` [°].
+
+    Args:
+        config: the tuning config (its `manual` and `plant`).
+        level: the step's target [°].
+
+    Returns:
+        The chosen gains (K_p, K_i, K_d) and every experiment with its decision.
+
+    Raises:
+        InfeasibleError: the smallest K_p already gives swings that grow or persist.
+    """
     m = config.manual
     reference = step_reference((level,), m.hold, config.plant.pwm_period)
     rig = SimulatedRig(config.plant, reference, manual_seed(config, level))
@@ -88,9 +140,19 @@ def auto_run(
 ) -> TuningRun:
     """Coordinate descent of M (2.5) on steps through `levels` [°]; `index` picks the seed.
 
-    `rig` runs one experiment with gains K [K_p, K_i, K_d] and returns its response; by
-    default the simulated actuator (SimulatedRig, noise seed `auto_seed(config, index)`),
-    else, e.g., rigs.pneunet.PneuNetRig on a real or emulated rig with the same program."""
+    Args:
+        config: the tuning config (its `auto` and `plant`).
+        levels: the reference levels, held in order [°].
+        index: number of the run: seeds its random K and dK, with `auto.seed`, and its noise
+            (auto_seed).
+        rig: runs one experiment with gains K = (K_p, K_i, K_d) and returns its response [°];
+            None: the simulated actuator (SimulatedRig, noise seed `auto_seed(config,
+            index)`), else, e.g., rigs.pneunet.PneuNetRig on a real or emulated rig with the
+            same program.
+
+    Returns:
+        The levels and the descent's result: the tuned gains, their cost and every sweep.
+    """
     a = config.auto
     rng = np.random.default_rng([a.seed, index])
     if rig is None:
@@ -110,12 +172,28 @@ def auto_run(
 
 
 def manual_seed(config: TuningConfig, level: float) -> int:
-    """The first noise seed of the manual procedure on a step to `level` [°]."""
+    """The first noise seed of the manual procedure on a step to `level` [°].
+
+    Args:
+        config: the tuning config (its `manual.seed`).
+        level: the step's target [°].
+
+    Returns:
+        manual.seed + 100·int(level).
+    """
     return config.manual.seed + int(level) * 100
 
 
 def auto_seed(config: TuningConfig, index: int) -> int:
-    """The first noise seed of tuning run `index` (each experiment of the run takes the next)."""
+    """The first noise seed of tuning run `index` (each experiment of the run takes the next).
+
+    Args:
+        config: the tuning config (its `auto.seed`).
+        index: number of the tuning run.
+
+    Returns:
+        1000·auto.seed + 100 000·index.
+    """
     return config.auto.seed * 1000 + index * 100_000
 
 
@@ -123,10 +201,15 @@ def auto_seed(config: TuningConfig, index: int) -> int:
 class KdProbe:
     """Paired experiments of one gain set with its K_d replaced by each value of `kd`.
 
-    cost: M (2.5) per K_d and experiment, (len(kd), n). swings: swings of the sensor reading
-    beyond the noise band about each level, summed over the levels, (len(kd), n).
-    sustained: whether some level's swings do not die out (StepFeatures.sustained), same
-    shape. Arrays are read-only.
+    The arrays are read-only; n is the number of experiments per K_d.
+
+    Attributes:
+        kd: the K_d values tried [counts·s/°].
+        cost: M (2.5) per K_d and experiment, shape (len(kd), n).
+        swings: swings of the sensor reading beyond the noise band about each level, summed
+            over the levels, shape (len(kd), n).
+        sustained: whether some level's swings do not die out (StepFeatures.sustained),
+            shape (len(kd), n).
     """
 
     kd: tuple[float, ...]
@@ -149,8 +232,20 @@ def kd_probe(
     """M (2.5) and swings of `seeds` step experiments for the gains with K_d set to each value.
 
     Every K_d sees the same noise seeds, so differences between K_d values are paired; the
-    experiments run as one batch, which gives the numbers of running them one by one. `band`
-    [°] is the noise band of the swing count.
+    experiments run as one batch, which gives the numbers of running them one by one.
+
+    Args:
+        plant: the simulated PneuNet's constants (the nominal actuator in every experiment).
+        gains: the gain set (K_p, K_i, K_d); its K_p and K_i are kept.
+        levels: the reference levels, held in order [°].
+        hold: time each level is held [s].
+        kd_values: the K_d values to try [counts·s/°].
+        seeds: number of experiments per K_d (noise seeds 50 000, 50 001, …).
+        band: noise band of the swing count [°].
+
+    Returns:
+        Per K_d and experiment, shape (len(kd_values), seeds): the cost M, the swings and
+            whether they are sustained.
     """
     reference = step_reference(levels, hold, plant.pwm_period)
     per_level = reference.size // len(levels)

@@ -21,12 +21,22 @@ MIN_SAMPLES_AFTER = 2  # sensor samples after deactuation: the metrics need a st
 class DeactuationConfig(StrictModel):
     """One actuate-hold-deactuate run of Sect. 3.4 (Fig. 3.7); times [s], pressures gauge [Pa].
 
-    side_deg [deg] is the pressurised side (chamber i at 60°·i; between chambers the two
-    nearest share it); pressure defaults to the pump's supply. The side is filled at t = 0 and
-    held at its pressure (a chamber below supply is pressure-regulated: its fill valve reopens
-    whenever the bend lets its pressure fall), vented at t = hold, and the run ends `after`
-    seconds later. band_deg [deg] is the settling
-    band about rest.
+    The side is filled at t = 0 and held at its pressure (a chamber below supply is
+    pressure-regulated: its fill valve reopens whenever the bend lets its pressure fall),
+    vented at t = hold, and the run ends `after` seconds later.
+
+    Attributes:
+        seed: seed of the orientation sensor's noise.
+        dt: RK4 integration step, at most 1 ms and dividing the 1 ms trace interval [s].
+        hold: time from filling the side (t = 0) to venting it [s].
+        after: time simulated after the vent [s].
+        side_deg: the pressurised side, chamber i at 60°·i; between chambers the two nearest
+            share it [deg].
+        pressure: gauge pressure the side is held at [Pa]; None: the pump's supply.
+        band_deg: settling band about rest [deg].
+        actuator: the six-chamber actuator's constants, valves and air.
+        sensor: the orientation sensor's rate and noise.
+        damping: the active-damping pulse on the opposite side, Eq. (3.4); δ = 0: none.
     """
 
     seed: Seed = 0
@@ -75,7 +85,15 @@ class DeactuationConfig(StrictModel):
 
 
 def simulate_deactuation(config: DeactuationConfig) -> Deactuation:
-    """Run the plant and the sensor for one config."""
+    """Run the plant and the sensor for one config.
+
+    Args:
+        config: the run's config.
+
+    Returns:
+        The plant's samples (every 1 ms), the sensor's samples, the bending direction and
+            the deactuation instant.
+    """
     program = valve_program(config.actuator, config.side_deg, config.gauge, config.hold,
                             config.damping)  # fmt: skip
     return deactuate(
@@ -89,8 +107,18 @@ def oscillation_metrics(
 ) -> dict[str, float]:
     """Peak, overshoot and settling of a signed angle [rad] (positive toward the bend) after t_off.
 
-    peak: largest |angle| after it first crosses rest; overshoot: largest swing past rest over
-    the angle at deactuation; settling: time after t_off from which |angle| stays within band.
+    Args:
+        t: sample times, shape (n,) [s].
+        angle: signed bending angle at those times, shape (n,) [rad].
+        t_off: deactuation instant [s].
+        band: settling band about rest [rad].
+
+    Returns:
+        Metric name -> value: peak, the largest |angle| after it first crosses rest (0 if it
+            never does) [rad]; overshoot, the largest swing past rest over the angle at
+            deactuation (NaN if that angle is not positive); settling, the time after t_off
+            from which |angle| stays within band [s] (NaN if it never does); start, the
+            angle at deactuation [rad].
     """
     after = t >= t_off - 1e-12
     ta, a = t[after], angle[after]
@@ -113,6 +141,17 @@ def run_metrics(run: Deactuation, band_deg: float) -> dict[str, float]:
 
     Settling times are sample instants, rounded to 1 µs to drop float noise (0.93, not
     0.9300000000000002).
+
+    Args:
+        run: the simulated run (simulate_deactuation).
+        band_deg: settling band about rest [deg].
+
+    Returns:
+        Metric name -> value. On the sensor: peak_deg [deg], overshoot_pct [%], settling_s
+            [s] (NaN: not settled by the end) and deactuation_angle_deg [deg]; on the true
+            angle: peak_true_deg [deg], overshoot_true_pct [%] and settling_true_s [s];
+            opposite_peak_pressure, the largest gauge pressure after deactuation in the
+            chambers on the side bent toward [Pa].
     """
     band = np.radians(band_deg)
     sensed = oscillation_metrics(run.sensor_t, run.sensor_bend @ run.direction, run.t_off, band)
@@ -139,7 +178,18 @@ def _opposite_peak(run: Deactuation) -> float:
 
 
 def run_deactuation(config: DeactuationConfig, progress: Progress | None = None) -> Result:
-    """Simulate one run; metrics on the sensor signal and the truth, trace at 1 kHz."""
+    """Simulate one run; metrics on the sensor signal and the truth, trace at 1 kHz.
+
+    Args:
+        config: the run's config.
+        progress: not used: the run reports no progress.
+
+    Returns:
+        The metrics of run_metrics and the trace: t [s]; bend, the true bending angle toward
+            the side, its components bend_x and bend_y, and bend_sensor, the sensor's latest
+            sample toward the side [rad]; p0-p5, the chambers' gauge pressures [Pa];
+            valve0-valve5, their valve modes.
+    """
     run = simulate_deactuation(config)
     sim = run.sim
     held = np.searchsorted(run.sensor_t, sim.t, side="right") - 1

@@ -19,7 +19,15 @@ MIN_STEADY_SAMPLES = 10
 
 
 class CurrentReference(StrictModel):
-    """Current reference i_ref(t) = current + amplitude·sin(frequency·t) and the shaft speed."""
+    """Current reference i_ref(t) = current + amplitude·sin(frequency·t) and the shaft speed.
+
+    Attributes:
+        current: constant part i_ss of the reference [A].
+        speed: shaft speed ω_ss the feed-forward of Eq. (4.13) assumes, held by the
+            secondary motor on the dual rig [rad/s].
+        amplitude: amplitude of the sinusoidal part [A]; 0: a constant reference.
+        frequency: angular frequency of the sinusoidal part [rad/s].
+    """
 
     current: Finite = 1.0  # i_ss [A]
     speed: Finite = 5.0  # ω_ss [rad/s], held by the secondary on the dual rig
@@ -28,7 +36,14 @@ class CurrentReference(StrictModel):
 
 
 class CurrentControllerConfig(StrictModel):
-    """PI gains of Eq. (4.14) and the moving-average order of Eq. (4.17) (1 = unfiltered)."""
+    """PI gains of Eq. (4.14) and the moving-average order of Eq. (4.17) (1 = unfiltered).
+
+    Attributes:
+        kp: proportional gain K_p, Eq. (4.14) [V/A].
+        ki: integral gain K_i, Eq. (4.14) [V/(A·s)].
+        filter_order: length of the moving average on the measured current, Eq. (4.17)
+            [samples]; 1: unfiltered.
+    """
 
     kp: NonNegative = 10.0  # [V/A]
     ki: NonNegative = 100.0  # [V/(A·s)]
@@ -36,21 +51,49 @@ class CurrentControllerConfig(StrictModel):
 
 
 class SpeedControllerConfig(StrictModel):
-    """PI gains of the secondary motor's speed loop, Eq. (4.12); the book gives none."""
+    """PI gains of the secondary motor's speed loop, Eq. (4.12); the book gives none.
+
+    Attributes:
+        kp: proportional gain [V·s/rad].
+        ki: integral gain [V/rad].
+    """
 
     kp: NonNegative = 5.0  # [V·s/rad]
     ki: NonNegative = 10.0  # [V/rad]
 
 
 class PwmConfig(StrictModel):
-    """Motor driver: supply V_max and duty register bits N of Eq. (4.15) (0 = ideal driver)."""
+    """Motor driver: supply V_max and duty register bits N of Eq. (4.15) (0 = ideal driver).
+
+    Attributes:
+        bits: duty register bits N of Eq. (4.15); 0: ideal driver (saturation only).
+        v_max: supply voltage V_max, the largest |V| the driver gives [V].
+    """
 
     bits: Annotated[int, Field(ge=0, le=16)] = 8
     v_max: Positive = 12.0  # [V]
 
 
 class CurrentControlConfig(StrictModel):
-    """One closed-loop current-control run of Sect. 4.4."""
+    """One closed-loop current-control run of Sect. 4.4.
+
+    Attributes:
+        seed: seed of the current sensor's noise.
+        rig: "single", the motor alone, or "dual", with the secondary motor on its shaft
+            holding the speed.
+        preset: the book's motor constants, Table 4.1 or Table 4.2.
+        motor: motor constants that override `preset`; None: the preset's.
+        dt: control period, at most 0.1 s [s].
+        duration: length of the run [s].
+        settle: time before the steady-state metrics are taken; rise times are found before
+            it [s].
+        reference: the current reference and the shaft speed.
+        controller: the current PI and its moving-average filter.
+        speed_controller: the secondary motor's speed PI (dual rig only).
+        pwm: the motor driver.
+        sensor: the current sensor (ACS712-5A on the Arduino's ADC).
+        encoder: the shaft encoder.
+    """
 
     seed: Seed = 0
     rig: Literal["single", "dual"] = "dual"
@@ -115,7 +158,15 @@ class CurrentControlConfig(StrictModel):
 
 
 def loop_settings(config: CurrentControlConfig) -> LoopSettings:
-    """Flatten a config into the numbers the compiled loop takes."""
+    """Flatten a config into the numbers the compiled loop takes.
+
+    Args:
+        config: the run's config.
+
+    Returns:
+        Its gains, sensor, encoder, PWM and control period as plain numbers, with the
+            feed-forward voltage of Eq. (4.13) for the reference's current and speed.
+    """
     p, c = config.params, config
     return LoopSettings(
         dt=c.dt, v_bias=feedforward_voltage(p, c.reference.current, c.reference.speed),
@@ -131,18 +182,40 @@ def loop_settings(config: CurrentControlConfig) -> LoopSettings:
 
 
 def time_axis(config: CurrentControlConfig) -> np.ndarray:
-    """Sample instants [s]."""
+    """Sample instants [s].
+
+    Args:
+        config: the run's config.
+
+    Returns:
+        k·dt for every control period k, shape (steps,) [s].
+    """
     return np.arange(config.steps) * config.dt
 
 
 def current_reference(config: CurrentControlConfig) -> np.ndarray:
-    """i_ref at every sample [A]."""
+    """i_ref at every sample [A].
+
+    Args:
+        config: the run's config.
+
+    Returns:
+        current + amplitude·sin(frequency·t), shape (steps,) [A].
+    """
     r = config.reference
     return r.current + r.amplitude * np.sin(r.frequency * time_axis(config))
 
 
 def metric_window(config: CurrentControlConfig) -> MetricWindow:
-    """Steady-state start, rise target and fitting frequency of a config's metrics."""
+    """Steady-state start, rise target and fitting frequency of a config's metrics.
+
+    Args:
+        config: the run's config.
+
+    Returns:
+        The first sample at or after `settle`; the step target of the rise times [A] (NaN
+            for a sinusoid or a step to 0); the sinusoid's frequency [rad/s] (0: none).
+    """
     ref = config.reference
     sinusoid = ref.amplitude > 0 and ref.frequency > 0
     return MetricWindow(
@@ -160,6 +233,17 @@ def simulate_batch(
 
     Trial 0 equals the single run of the same config: all draws come from one Generator
     seeded with `config.seed`, row by row. Channels are (trials, steps) arrays.
+
+    Args:
+        config: the run's config.
+        trials: number of noise realisations.
+        record: keep the channels; False saves the memory of long Monte Carlo batches.
+
+    Returns:
+        channels: name -> (trials, steps) array: i, i_meas, i_fb [A], omega, omega_meas
+            [rad/s], v1 [V], duty1 [counts], v2 [V] and i_ref [A]; None when `record` is
+            False.
+        metrics: name -> per-trial value, shape (trials,) (metrics_from_sums).
     """
     rng = np.random.default_rng(config.seed)
     steps = config.steps
@@ -187,6 +271,18 @@ def metrics_from_sums(
     the filter's lag on a moving signal is not counted as noise; rise times are 10-90 % of
     the step from rest, found before `settle`; amplitude_ratio and phase_lag [rad, positive
     when lagging] come from a least-squares fit c + a·sin(ωt) + b·cos(ωt) of the current.
+
+    Args:
+        config: the run's config.
+        window: the window the sums were taken over (metric_window).
+        sums: the loop's running sums, name -> shape (trials,) (simulate_loop).
+
+    Returns:
+        Name -> per-trial value, shape (trials,): steady_state_error (mean of i − i_ref),
+            current_rms_error and noise_rms [A]; speed_mean [rad/s]; saturation_fraction,
+            the share of all steps at full voltage; rise_time and rise_time_feedback (of the
+            fed-back current) [s], NaN when there is none; amplitude_ratio and phase_lag
+            [rad], NaN without a sinusoidal reference.
     """
     t = time_axis(config)[window.settle_index :]
     n = t.size
@@ -215,7 +311,16 @@ def metrics_from_sums(
 
 
 def run_current_control(config: CurrentControlConfig, progress: Progress | None = None) -> Result:
-    """Simulate one run and return its metrics and trace."""
+    """Simulate one run and return its metrics and trace.
+
+    Args:
+        config: the run's config.
+        progress: not used: the run reports no progress.
+
+    Returns:
+        The metrics of metrics_from_sums and the trace: t [s] and the channels of
+            simulate_batch.
+    """
     channels, metrics = simulate_batch(config, trials=1)
     trace = {"t": time_axis(config), **{k: v[0] for k, v in (channels or {}).items()}}
     return Result(metrics={k: float(v[0]) for k, v in metrics.items()}, trace=trace)
