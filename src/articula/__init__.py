@@ -1,5 +1,7 @@
 """articula: control and decision-making for articulated robots and their soft end-effectors."""
 
+import importlib.metadata
+
 from articula.errors import (
     ArticulaError,
     ConfigError,
@@ -9,7 +11,7 @@ from articula.errors import (
     ModelError,
 )
 
-__version__ = "0.1.0"
+__version__ = importlib.metadata.version("articula")  # pyproject.toml's, as installed
 
 __all__ = [
     "ArticulaError",

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 import typer
 
-from articula.cli import _command, app, main
+from articula.cli import app, main
 
 
 def run(capsys, *argv: str) -> str:
@@ -62,10 +62,6 @@ def test_a_flag_shows_no_type_and_a_value_a_word(capsys):
     text = run(capsys, "plan", "--help")
     assert re.search(r"^\s*--json\s+Print one JSON object", text, re.M), text
     assert re.search(r"^\s*--out FOLDER\s", text, re.M), text
-
-
-def test_the_click_command_is_built_once_per_call():
-    assert _command() is not _command()
 
 
 def test_live_record_into_a_foreign_folder_names_record_and_force(main_fails, tmp_path):

@@ -144,3 +144,17 @@ def test_a_start_in_collision_is_named_as_plan_names_it(main_fails, tmp_path):
     scene.write_text(tomli_w.dumps(config))
     line = main_fails("live", scene, "--port", "1")
     assert line.startswith(f"error: {scene}: robot.q0: the start collides with itself"), line
+
+
+def test_the_panel_switches_a_baornn_scene_with_an_acceleration_limit_to_qp(server, tmp_path):
+    config = load_toml(CONFIGS / "circle_one_obstacle.toml")
+    config["obstacles"] = []
+    config["planner"] |= {"method": "baornn-improved", "max_acceleration": 5.0}
+    path = tmp_path / "scene.toml"
+    path.write_text(tomli_w.dumps(config))
+    live = Live(server, LiveScene.load(path))
+    live.method.value = "qp"
+    live.rebuild()
+    assert "not changed" not in live.readout.content, live.readout.content
+    assert live.spec().method == "qp"
+    live.close()

@@ -35,7 +35,7 @@ def reproduce(
     """Reproduce the book's figures and tables into OUT/report.md and PNG figures.
 
     \b
-    Example: articula reproduce all --out report (or ch1 ... ch4; --full for the full size)
+    Example: articula reproduce ch4 --out report --full
     """
     from articula.book.reproduce import check_chapter
     from articula.book.reproduce import reproduce as run_reproduce

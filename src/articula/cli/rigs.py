@@ -59,9 +59,10 @@ def emulate(
 ) -> None:
     """Start a simulated rig behind a pseudo-terminal and print its device path.
 
+    Point `articula rig info / run / record / tune` at the path it prints.
+
     \b
-    Example: articula emulate motor --firmware firmware/build/motor.elf, then articula rig
-    info <the path it prints>"""
+    Example: articula emulate motor --firmware firmware/build/motor.elf"""
     from articula.errors import ConfigError
 
     if rig not in RIGS:
@@ -180,7 +181,7 @@ def run_(
     """Run an experiment config on the rig; the run folder is written as samples arrive.
 
     \b
-    Example: articula rig run /dev/ttyACM0 my_pid.toml --out runs/rig (a pneunet.pid config)"""
+    Example: articula rig run /dev/ttyACM0 my_pid.toml --out runs/rig"""
     import importlib
 
     from articula.errors import ConfigError

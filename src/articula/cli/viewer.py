@@ -23,8 +23,10 @@ def view(
 ) -> None:
     """Replay a planned run in the browser: arm, obstacles, paths, closest pair, plots.
 
+    Open the URL it prints; Ctrl-C stops it.
+
     \b
-    Example: articula view runs/circle --port 8080, then open the URL it prints."""
+    Example: articula view runs/circle --port 8080"""
     from articula.viewer.replay import serve
 
     serve(run_dir, host, port, lambda url: out.print(f"viewer at {url} (Ctrl-C stops it)"))

@@ -111,7 +111,8 @@ class TrajectorySpec(StrictModel):
 
 
 class PlannerSpec(StrictModel):
-    """[planner]: the method and its parameters; keys a method does not use are ignored.
+    """[planner]: the method and its parameters; keys a method does not use are ignored,
+    except max_acceleration, which only the BAORNN methods honour and the others refuse.
 
     Attributes:
         method: "baornn", "baornn-improved", or the baselines "pinv", "dls" and "qp".

@@ -165,7 +165,10 @@ class Live:
         """
         panel = {"method": self.method.value, "lambda_weight": float(self.lam.value),
                  "d_min": float(self.d_min.value)}  # fmt: skip
-        return PlannerSpec(**(self.config["planner"] | panel))
+        planner = self.config["planner"] | panel
+        if panel["method"] not in ("baornn", "baornn-improved"):
+            planner.pop("max_acceleration", None)  # BAORNN's alone; the others refuse it
+        return PlannerSpec(**planner)
 
     def rebuild(self) -> None:
         """A new controller from the panel's settings, started from the arm where it is; on
