@@ -132,6 +132,18 @@ def test_bad_ports_and_options_are_one_line_and_exit_2(cli, args, words):
     assert len(proc.stderr.strip().splitlines()) == 1 and words in proc.stderr
 
 
+@pytest.mark.parametrize(
+    "command",
+    [["record", "--duration", "1"], ["tune"], ["run", str(packaged("ch4", "fig4_5.toml"))]],
+    ids=["record", "tune", "run"],
+)
+def test_a_port_that_does_not_open_leaves_no_output_folder(cli, tmp_path, command):
+    verb, *rest = command
+    proc = cli("rig", verb, "/dev/no-such-rig", *rest, "--out", tmp_path / "out")
+    assert proc.returncode == 2 and "cannot open the port" in proc.stderr, proc.stderr
+    assert not (tmp_path / "out").exists()
+
+
 def test_rig_tune_reaches_the_in_process_gains(emulated_pneunet, cli, tmp_path):
     config = tmp_path / "tuning.toml"
     config.write_text("[auto]\nseed = 2000\nhold = 2.0\nmax_iterations = 5\n")
