@@ -59,7 +59,7 @@ def free_port() -> int:
 
 @pytest.fixture
 def viewer() -> Iterator[Callable[..., tuple[subprocess.Popen, str]]]:
-    """viewer(*args) starts `articula <args> --port P` and waits for its URL line; (process,
+    """viewer(*args) starts `articula <args> --port P` and reads its first line, the URL; (process,
     url). Every process started is stopped after the test."""
     started: list[subprocess.Popen] = []
 
@@ -70,10 +70,10 @@ def viewer() -> Iterator[Callable[..., tuple[subprocess.Popen, str]]]:
         proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         started.append(proc)
         assert proc.stdout is not None
-        for line in proc.stdout:  # until its URL line, or its end (then stdout closes)
-            if f"http://127.0.0.1:{port} (Ctrl-C stops it)" in line:
-                return proc, f"http://127.0.0.1:{port}"
-        raise AssertionError(f"the viewer exited: {proc.wait()} {proc.stderr.read()}")
+        line = proc.stdout.readline()  # its URL line is all it prints (no viser banner)
+        if f"http://127.0.0.1:{port} (Ctrl-C stops it)" in line:
+            return proc, f"http://127.0.0.1:{port}"
+        raise AssertionError(f"the viewer printed {line!r}, exit {proc.poll()}")
 
     yield start
     for proc in started:

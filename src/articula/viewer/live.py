@@ -343,7 +343,7 @@ def run_live(scene_file: Path, method: str | None, host: str, port: int, record:
         record: the run folder to write the session to at the end; None: none.
         announce: called as announce(url) once the page is served.
     """
-    from articula.viewer.replay import open_server
+    from articula.viewer.replay import open_server, stop_server
 
     loaded = LiveScene.load(scene_file, method)  # a bad file fails before the port opens
     server = open_server(host, port)
@@ -366,6 +366,6 @@ def run_live(scene_file: Path, method: str | None, host: str, port: int, record:
     finally:
         if live is not None:
             live.close()
-        server.stop()
+        stop_server(server)
     if record is not None and live is not None:
         live.write(record, time.monotonic() - started)

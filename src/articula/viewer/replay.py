@@ -18,6 +18,7 @@ import viser
 import viser.uplot as uplot
 
 from articula.errors import ConfigError
+from articula.native import captured_output
 from articula.viewer import drawing
 from articula.viewer.run_data import RunData, load_run, run_folders
 
@@ -158,7 +159,18 @@ def open_server(host: str, port: int) -> viser.ViserServer:
         except OSError as exc:
             raise ConfigError("--port", f"cannot listen on {host}:{port} ({exc.strerror}); "
                               "choose another port") from None  # fmt: skip
-    return viser.ViserServer(host=host, port=port, verbose=False)
+    with captured_output():  # viser's banner: the command prints its own one line
+        return viser.ViserServer(host=host, port=port, verbose=False)
+
+
+def stop_server(server: viser.ViserServer) -> None:
+    """Stop a server of open_server without viser's "Server stopped" line.
+
+    Args:
+        server: the running server.
+    """
+    with captured_output():
+        server.stop()
 
 
 def serve(folder: Path, host: str, port: int, announce) -> None:
@@ -186,4 +198,4 @@ def serve(folder: Path, host: str, port: int, announce) -> None:
     except KeyboardInterrupt:
         return
     finally:
-        server.stop()
+        stop_server(server)
