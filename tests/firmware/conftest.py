@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from articula.rigs.firmware import FirmwareRig, PinPlant
+from tests.conftest import ARTICULA
 
 FIRMWARE = Path(__file__).resolve().parents[2] / "firmware"
 TOOLCHAIN = "apt-get install -y gcc-avr avr-libc simavr libsimavr-dev"
@@ -62,3 +63,28 @@ def on_plant(built) -> Iterator[Callable[[str, PinPlant], FirmwareRig]]:
     yield run
     for rig in rigs:
         rig.close()
+
+
+@pytest.fixture
+def emulated(built) -> Iterator[Callable[[str], tuple[subprocess.Popen, str]]]:
+    """emulated(rig): `articula emulate RIG --firmware build/<rig>.elf` as a process, and the
+    device path of its first line; every process is stopped (SIGTERM, then SIGKILL) after."""
+    started: list[subprocess.Popen] = []
+
+    def run(rig: str) -> tuple[subprocess.Popen, str]:
+        elf = built / f"{rig.replace('-', '_')}.elf"
+        proc = subprocess.Popen([ARTICULA, "emulate", rig, "--firmware", elf],
+                                stdout=subprocess.PIPE, text=True)  # fmt: skip
+        started.append(proc)
+        line = proc.stdout.readline()  # "RIG rig at /dev/pts/N (Ctrl-C stops it)"
+        assert " rig at " in line, f"emulate printed {line!r}, exit {proc.poll()}"
+        return proc, line.split()[3]
+
+    yield run
+    for proc in started:
+        proc.terminate()
+        try:
+            proc.wait(10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait(10)

@@ -8,7 +8,6 @@ from __future__ import annotations
 import os
 import select
 import signal
-import subprocess
 import time
 
 import numpy as np
@@ -21,7 +20,6 @@ from articula.rigs.pneunet import PneuNetPins, PneuNetRig
 from articula.rigs.programs import steps
 from articula.rigs.protocol import Kind, RigKind
 from articula.rigs.run import run_program
-from tests.conftest import ARTICULA
 
 pytestmark = pytest.mark.firmware
 GAINS = np.array([2.0, 1.5, 0.05])
@@ -109,12 +107,10 @@ def _children(pid: int) -> list[int]:
     return found
 
 
-def test_emulate_with_firmware_stopped_by_sigterm_stops_its_harness(built):
-    proc = subprocess.Popen([ARTICULA, "emulate", "pneunet", "--firmware", built / "pneunet.elf"],
-                            stdout=subprocess.PIPE, text=True)  # fmt: skip
+def test_emulate_with_firmware_stopped_by_sigterm_stops_its_harness(emulated):
+    proc, _ = emulated("pneunet")
     harness: list[int] = []
     try:
-        assert " rig at " in proc.stdout.readline()
         harness = _children(proc.pid)
         assert len(harness) == 1
         with open(f"/proc/{harness[0]}/cmdline", "rb") as cmdline:

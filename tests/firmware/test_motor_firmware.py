@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
 
 import numpy as np
 import pytest
@@ -27,7 +26,6 @@ from articula.rigs.link import Link
 from articula.rigs.protocol import RigKind
 from articula.rigs.recorder import Recorder
 from articula.validation import load_toml, parse_model
-from tests.conftest import ARTICULA
 
 pytestmark = pytest.mark.firmware
 FIGURES = ["fig4_5", "fig4_6", "fig4_7", "fig4_8", "fig4_9"]
@@ -91,16 +89,10 @@ def test_a_config_the_firmware_is_not_built_for_is_refused_by_field():
             update={"counts_per_rev": 500})}))  # fmt: skip
 
 
-def test_emulate_motor_with_firmware_runs_a_figure_from_the_command_line(built, cli, tmp_path):
-    proc = subprocess.Popen([ARTICULA, "emulate", "motor", "--firmware", built / "motor.elf"],
-                            stdout=subprocess.PIPE, text=True)  # fmt: skip
-    try:
-        path = proc.stdout.readline().split()[3]  # "motor rig at /dev/pts/N (Ctrl-C ...)"
-        config = packaged("ch4", "fig4_8.toml")
-        done = cli("rig", "run", path, config, "--out", tmp_path / "run", "--json")
-    finally:
-        proc.terminate()
-        proc.wait(10)
+def test_emulate_motor_with_firmware_runs_a_figure_from_the_command_line(emulated, cli, tmp_path):
+    _, path = emulated("motor")
+    config = packaged("ch4", "fig4_8.toml")
+    done = cli("rig", "run", path, config, "--out", tmp_path / "run", "--json")
     assert done.returncode == 0, done.stderr
     record = json.loads(done.stdout)
     assert record["complete"] and record["samples"] == figure_config("fig4_8").steps

@@ -10,7 +10,6 @@ travel as float32; the runs agree to about 1e-3 of the peak."""
 from __future__ import annotations
 
 import json
-import subprocess
 from pathlib import Path
 
 import pytest
@@ -24,7 +23,6 @@ from articula.rigs.link import Link
 from articula.rigs.protocol import RigKind
 from articula.rigs.recorder import Recorder
 from articula.rigs.six_chamber import SixChamberPins, fill_table_header
-from tests.conftest import ARTICULA
 
 pytestmark = pytest.mark.firmware
 HEADER = Path(__file__).resolve().parents[2] / "firmware/src/fill_table.h"
@@ -85,19 +83,12 @@ def test_the_fill_table_in_the_firmware_is_the_models():
     assert HEADER.read_text() == fill_table_header(SixChamberParams())
 
 
-def test_emulate_six_chamber_with_firmware_runs_from_the_command_line(built, cli, tmp_path):
+def test_emulate_six_chamber_with_firmware_runs_from_the_command_line(emulated, cli, tmp_path):
     config = tmp_path / "damping.toml"
     config.write_text('experiment = "softarm.damping"\nseed = 4\nhold = 1.0\nafter = 1.0\n'
                       "[damping]\ndelta = 0.3\nstart = 0.15\nlength = 0.045\n")  # fmt: skip
-    elf = built / "six_chamber.elf"
-    proc = subprocess.Popen([ARTICULA, "emulate", "six-chamber", "--firmware", elf],
-                            stdout=subprocess.PIPE, text=True)  # fmt: skip
-    try:
-        path = proc.stdout.readline().split()[3]  # "six-chamber rig at /dev/pts/N (...)"
-        done = cli("rig", "run", path, config, "--out", tmp_path / "run", "--json")
-    finally:
-        proc.terminate()
-        proc.wait(10)
+    _, path = emulated("six-chamber")
+    done = cli("rig", "run", path, config, "--out", tmp_path / "run", "--json")
     assert done.returncode == 0, done.stderr
     record = json.loads(done.stdout)
     assert record["complete"] and record["samples"] == 201
