@@ -258,9 +258,7 @@ int main(void) {
     TCCR4B = _BV(WGM42) | _BV(CS40);
     OCR1A = TICKS - 1; /* TOP first: the timer starts with its clock (simavr reads TOP then) */
     TCCR1B = _BV(WGM12) | _BV(CS10); /* CTC: the 1 kHz control tick */
-    ADMUX = _BV(REFS0) | 1;                                /* AVCC reference, A1 */
-    ADCSRA = _BV(ADEN) | _BV(ADPS2) | _BV(ADPS1) | _BV(ADPS0); /* 125 kHz ADC clock */
-    ADCSRA |= _BV(ADIE) | _BV(ADSC); /* the first, long conversion now (ignored at rest) */
+    adc_start(1); /* the ACS712 on A1 */
     EICRB = _BV(ISC40) | _BV(ISC50); /* D2/D3 (INT4/INT5): any edge */
     EIMSK = _BV(INT4) | _BV(INT5);
     rig_serve(&motor);

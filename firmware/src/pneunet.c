@@ -202,8 +202,6 @@ int main(void) {
     ICR1 = TICKS - 1; /* TOP first: the timer starts with its clock (simavr reads TOP then) */
     TCCR1A = _BV(COM1A1) | _BV(WGM11); /* fast PWM, TOP = ICR1 */
     TCCR1B = _BV(WGM13) | _BV(WGM12) | _BV(CS11) | _BV(CS10); /* 16 MHz / 64 */
-    ADMUX = _BV(REFS0); /* AVCC reference, A0 */
-    ADCSRA = _BV(ADEN) | _BV(ADPS2) | _BV(ADPS1) | _BV(ADPS0);
-    ADCSRA |= _BV(ADIE) | _BV(ADSC); /* the first, long conversion now (ignored at rest) */
+    adc_start(0); /* the flex sensor on A0 */
     rig_serve(&pneunet);
 }

@@ -23,6 +23,12 @@ static volatile uint32_t samples;             /* of the run going on, or of the 
 static volatile uint8_t finished;             /* the interrupt's word that the run is over */
 static uint8_t channel_count;
 
+void adc_start(uint8_t channel) {
+    ADMUX = _BV(REFS0) | channel;
+    ADCSRA = _BV(ADEN) | _BV(ADPS2) | _BV(ADPS1) | _BV(ADPS0); /* 16 MHz / 128 */
+    ADCSRA |= _BV(ADIE) | _BV(ADSC);
+}
+
 void rig_sample(const float *values) {
     uint8_t next = (uint8_t)((ring_head + 1) % RING);
     if (next != ring_tail) { /* full: the sample is not sent (the host sees the gap) */

@@ -35,6 +35,9 @@ void rig_serve(const struct rig *rig);
 void rig_sample(const float *values);
 /* From the control interrupt: the run is over (after its last sample). */
 void rig_done(void);
+/* The ADC on analog input `channel` (AVCC reference, 125 kHz clock, its interrupt on), with
+ * its first, long conversion started now, so it is over (and ignored) before any run. */
+void adc_start(uint8_t channel);
 
 /* The little-endian float32 at body[offset] (AVR floats are IEEE-754 single, little-endian). */
 float read_float(const uint8_t *body, uint8_t offset);
