@@ -23,6 +23,23 @@ SELF_CONTACT_MARGIN = 1e-4
 
 
 @jit()
+def outside_omega(d: float, d_self: float, d_min: float) -> bool:
+    """Whether a point is outside Ω: not d > d_min (1.12), or its self clearance within
+    SELF_CONTACT_MARGIN (clearances are 0 on overlap, so d_min = 0 still rejects a point inside
+    an obstacle).
+
+    Args:
+        d: the point's smallest link-obstacle clearance [m].
+        d_self: its smallest clearance between link pairs that count [m].
+        d_min: the hard clearance of Eq. (1.12) [m].
+
+    Returns:
+        True when the projection must keep the current point.
+    """
+    return d <= d_min or d_self <= SELF_CONTACT_MARGIN
+
+
+@jit()
 def _task_error(ee, ee_R, x_ref, orient):  # fmt: skip
     """||x_r − f(θ)|| (Eq. 1.5), plus weight · orientation error for a pose or axis task;
     orient = (task code, weight, tool axis, reference rotation, reference axis)."""
@@ -40,13 +57,11 @@ def _project_and_value(
     arrays, static_min,
 ):  # fmt: skip
     """(P_Ω(q), g there, the task error e there), Eqs. (1.17)-(1.18); stays at (q_current,
-    g_current, e_current) unless the clipped point keeps d > d_min (1.12) and its self
-    clearance above SELF_CONTACT_MARGIN: clearance is 0 on overlap, so d_min = 0 still rejects a
-    point inside an obstacle. The
-    pairs in `arrays` are the ones that count (an obstacle clearance of +inf: none)."""
+    g_current, e_current) when the clipped point is outside Ω (outside_omega). The pairs in
+    `arrays` are the ones that count (an obstacle clearance of +inf: none)."""
     clipped = np.minimum(np.maximum(q, lower), upper)
     d, d_self, ee, ee_R = _evaluate(clipped, *arrays, static_min)
-    if d <= d_min or d_self <= SELF_CONTACT_MARGIN:
+    if outside_omega(d, d_self, d_min):
         return q_current, g_current, e_current
     e = _task_error(ee, ee_R, x_ref, orient)  # Eq. (1.5), with the orientation term
     return clipped, _penalised(e, d, lambda_weight, beta), e

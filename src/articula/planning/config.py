@@ -43,6 +43,7 @@ from articula.validation import (
 )
 
 Method = Literal["baornn", "baornn-improved", "pinv", "dls", "qp"]
+ACCELERATION_METHODS = ("baornn", "baornn-improved")  # the methods max_acceleration limits
 Rpy = Annotated[list[Radians], Field(min_length=3, max_length=3)]
 Quaternion = Annotated[list[Finite], Field(min_length=4, max_length=4)]
 
@@ -192,7 +193,7 @@ class PlannerSpec(StrictModel):
             object.__setattr__(self, "settle", min(5.0, self.duration / 2))
         if self.settle >= self.duration:
             raise field_error("settle", f"must be shorter than duration = {self.duration} s")
-        if self.max_acceleration is not None and self.method not in ("baornn", "baornn-improved"):
+        if self.max_acceleration is not None and self.method not in ACCELERATION_METHODS:
             raise field_error(
                 "max_acceleration",
                 f"only baornn and baornn-improved limit joint acceleration, not {self.method}; "

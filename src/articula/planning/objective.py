@@ -9,7 +9,7 @@ import numpy as np
 import pinocchio as pin
 
 from articula.errors import ConfigError, ModelError
-from articula.planning.baornn_kernel import SELF_CONTACT_MARGIN
+from articula.planning.baornn_kernel import outside_omega
 from articula.planning.task import Target, Task, as_target, target_arrays
 from articula.scene.compiled_clearance import CompiledClearance
 from articula.scene.scene import Scene
@@ -174,7 +174,7 @@ class Objective:
         if self.compiled is not None:
             self.compiled.at(t)
             d, d_self, ee, ee_R = self.compiled.evaluate(clipped, self.needs_obstacles)
-            if d <= self.d_min or d_self <= SELF_CONTACT_MARGIN:  # Ω: d > d_min (1.12), self clear
+            if outside_omega(d, d_self, self.d_min):
                 return q_current, g_current
             return clipped, self._combine(self._task_error(target, ee, ee_R), d)
         if not (self.needs_obstacles or self.scene.self_pairs):
@@ -182,7 +182,7 @@ class Objective:
         d, d_self = self.scene.clearances(clipped, t)  # also leaves the joint placements updated
         if not self.needs_obstacles:
             d = np.inf
-        if d <= self.d_min or d_self <= SELF_CONTACT_MARGIN:  # Ω: d > d_min (1.12), self clear
+        if outside_omega(d, d_self, self.d_min):
             return q_current, g_current
         return clipped, self._value(clipped, target, d, kinematics_done=True)
 

@@ -21,7 +21,13 @@ import viser
 from articula.errors import ArticulaError
 from articula.loops.online import OnlineController
 from articula.loops.tracking import PlanResult, trace_columns, tracking_metrics
-from articula.planning.config import PlannerSpec, TrajectorySpec, absolute_paths, make_targets
+from articula.planning.config import (
+    ACCELERATION_METHODS,
+    PlannerSpec,
+    TrajectorySpec,
+    absolute_paths,
+    make_targets,
+)
 from articula.planning.target_path import TargetPath
 from articula.runs.records import build_record, write_run
 from articula.runs.registry import Result
@@ -166,7 +172,7 @@ class Live:
         panel = {"method": self.method.value, "lambda_weight": float(self.lam.value),
                  "d_min": float(self.d_min.value)}  # fmt: skip
         planner = self.config["planner"] | panel
-        if panel["method"] not in ("baornn", "baornn-improved"):
+        if panel["method"] not in ACCELERATION_METHODS:
             planner.pop("max_acceleration", None)  # BAORNN's alone; the others refuse it
         return PlannerSpec(**planner)
 
