@@ -16,6 +16,7 @@ LAYERS = {
     "errors": 0,
     "limits": 0,
     "native": 0,
+    "disk_cache": 0,
     "numba_cache": 1,
     "validation": 1,
     "__init__": 1,

@@ -37,6 +37,7 @@ duration = 1.0
 settle = 0.5
 seed = 0
 limits = "none"
+approach = "none"
 """
 CIRCLE = """type = "circle"
 center = [0.0, 0.6, 0.5]
@@ -62,9 +63,7 @@ def test_plan_writes_the_run_folder_contract(cli, tmp_path):
     assert keys <= set(record["metrics"])
     assert json.loads((out / "record.json").read_text()) == record
     table = pq.read_table(out / "trace.parquet")
-    columns = ["t", *[f"q_{j}" for j in range(1, 8)], "x", "y", "z", "x_ref", "y_ref", "z_ref",
-               "error", "clearance"]  # fmt: skip
-    assert table.column_names == columns
+    assert table.column_names == COLUMNS
     assert table.num_rows == 100
     assert record["metrics"]["collisions"] == 0 and record["metrics"]["joint_limit_violations"] == 0
 
@@ -117,8 +116,8 @@ def test_a_start_inside_the_obstacle_is_refused(cli, tmp_path, assert_one_line_e
 
 METHODS = ("baornn", "baornn-improved", "pinv", "dls", "qp")
 GUARDED = ("baornn", "baornn-improved", "qp")
-COLUMNS = ["t", *[f"q_{j}" for j in range(1, 8)], "x", "y", "z", "x_ref", "y_ref", "z_ref",
-           "error", "clearance"]  # fmt: skip
+COLUMNS = ["t", "phase", *[f"q_{j}" for j in range(1, 8)], "x", "y", "z", "x_ref", "y_ref",
+           "z_ref", "error", "clearance", "self_clearance"]  # fmt: skip
 
 
 def _short_scene(folder: Path, method: str, trajectory: str = CIRCLE) -> Path:
@@ -265,10 +264,12 @@ def test_a_scene_without_obstacles_plans_and_says_so(cli, tmp_path):
 
 def test_a_colliding_motion_writes_its_folder_and_exits_4_unless_allowed(cli, tmp_path):
     scene = (
-        _short_scene(tmp_path, "pinv")
+        _short_scene(tmp_path, "baornn")
         .read_text()
-        .replace("position = [0.35, 0.35, 0.6]", "position = [0.0, 0.2, 0.9]")
-    )  # the ball where the elbow swings through: pinv has no way to keep clear of it
+        .replace("position = [0.35, 0.35, 0.6]", "position = [0.2, 0.6, 0.5]")
+        .replace("lambda_weight = 0.002\nd_min = 0.002", "lambda_weight = 0.0\nd_min = 0.0")
+    )  # the ball on the path's start, and BAORNN told to ignore it (Λ = 0, as in Fig. 1.4)
+    assert "lambda_weight = 0.0\nd_min = 0.0" in scene
     path = tmp_path / "colliding.toml"
     path.write_text(scene)
     proc = cli("plan", path, "--out", tmp_path / "run", "--json")

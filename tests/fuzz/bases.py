@@ -4,8 +4,9 @@ Each config is validated by its experiment's own model and dumped back
 (`model_dump(mode="json", exclude_none=True)` plus its `experiment` key), so the fuzzer
 mutates the full schema, defaults included. Durations are tiny, so that a mutation the
 command still accepts stays cheap; the planner's tolerance is large, so tracking quality
-never decides the outcome. Files the configs name (the rock mesh, a waypoint CSV) are written
-beside them by `write_support_files`.
+never decides the outcome, and the path starts at once (no approach from the tool). Files
+the configs name (the rock mesh, a waypoint CSV) are written beside them by
+`write_support_files`.
 """
 
 from __future__ import annotations
@@ -82,7 +83,7 @@ WAYPOINTS = {
     "times": [0.0, 0.1, 0.3],
 }  # fmt: skip
 CSV_PATH = {"type": "csv", "path": CSV}
-PLANNER = {"duration": 0.2, "settle": 0.1, "dt": 0.01, "tolerance": 10.0}
+PLANNER = {"duration": 0.2, "settle": 0.1, "dt": 0.01, "tolerance": 10.0, "approach": "none"}
 
 
 def _plan(

@@ -100,8 +100,9 @@ def test_tracking_metrics_by_hand():
 def test_trace_columns_name_each_series():
     run = _hand_run()
     columns = trace_columns(run)
-    assert list(columns) == ["t", *(f"q_{j}" for j in range(1, 8)), "x", "y", "z",
+    assert list(columns) == ["t", "phase", *(f"q_{j}" for j in range(1, 8)), "x", "y", "z",
                              "x_ref", "y_ref", "z_ref", "error", "clearance"]  # fmt: skip
+    assert set(columns["phase"]) == {"path"}  # no approach
     np.testing.assert_array_equal(columns["q_1"], run.q[:, 0])
     np.testing.assert_array_equal(columns["y_ref"], run.x_ref[:, 1])
     np.testing.assert_array_equal(columns["clearance"], run.clearance)

@@ -61,7 +61,7 @@ def test_make_planner_builds_the_velocity_baselines(method):
 
 
 def test_make_planner_draws_all_randomness_from_the_seed():
-    spec = PlannerSpec(method="baornn", **BEETLE)
+    spec = PlannerSpec(method="baornn", limits="none", **BEETLE)
     q0, x_ref = np.zeros(ROBOT.nq), CIRCLE(0.0)
     steps = [make_planner(spec, SCENE, seed).step(q0, x_ref, 0.0) for seed in (1, 1, 2)]
     np.testing.assert_array_equal(steps[0], steps[1])
@@ -151,8 +151,19 @@ def test_a_run_longer_than_max_steps_is_refused_naming_how_to_raise_it():
     assert PlannerSpec(duration=2e4, max_steps=2_000_000).duration == 2e4
 
 
-@pytest.mark.parametrize("method", ["qp", "dls", "pinv"])
-def test_an_acceleration_limit_for_a_method_that_ignores_it_is_refused(method):
-    with pytest.raises(ConfigError, match=r"^scene\.toml: max_acceleration: only baornn"):
-        parse_model(PlannerSpec, {"method": method, "max_acceleration": 5.0}, "scene.toml")
-    parse_model(PlannerSpec, {"method": "baornn-improved", "max_acceleration": 5.0})
+@pytest.mark.parametrize("limits", ["velocity", "none"])
+def test_an_acceleration_override_without_acceleration_limits_is_refused(limits):
+    table = {"method": "qp", "limits": limits, "max_acceleration": 5.0}
+    with pytest.raises(ConfigError, match=r"^scene\.toml: max_acceleration: limits = "):
+        parse_model(PlannerSpec, table, "scene.toml")
+
+
+@pytest.mark.parametrize("method", ["baornn", "baornn-improved", "pinv", "dls", "qp"])
+def test_every_method_takes_the_robots_acceleration_limits_or_the_override(method):
+    planner = make_planner(PlannerSpec(method=method), SCENE, seed=0)
+    rate = planner.rate
+    np.testing.assert_allclose(rate.acceleration, ROBOT.acceleration_limit)
+    np.testing.assert_allclose(ROBOT.acceleration_limit, ROBOT.velocity_limit / 0.25)
+    override = make_planner(PlannerSpec(method=method, max_acceleration=5.0), SCENE, seed=0)
+    np.testing.assert_allclose(override.rate.acceleration, 5.0)
+    assert make_planner(PlannerSpec(method=method, limits="velocity"), SCENE, 0).rate.change is None

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from articula.errors import ConfigError
 from articula.loops.tracking import max_speed_ratio, track
@@ -24,11 +26,57 @@ def test_the_box_is_the_speed_reach_inside_the_joint_limits():
 def test_the_acceleration_limit_keeps_the_next_motion_near_the_last():
     rate = RateLimits(np.array([10.0, 10.0]), dt=0.1, acceleration=2.0)
     rate.record(np.array([0.5, 0.0]))
-    low, high = rate.box(np.zeros(2), 10 * LOWER, 10 * UPPER)
+    low, high = rate.box(np.zeros(2), 100 * LOWER, 100 * UPPER)
     np.testing.assert_allclose(low, [0.48, -0.02])
     np.testing.assert_allclose(high, [0.52, 0.02])
-    rate.reset()
-    np.testing.assert_allclose(rate.box(np.zeros(2), 10 * LOWER, 10 * UPPER)[1], [1.0, 1.0])
+    rate.reset()  # at rest: the first motion is an acceleration from zero
+    np.testing.assert_allclose(rate.box(np.zeros(2), 100 * LOWER, 100 * UPPER)[1], [0.02, 0.02])
+    assert not rate.strained
+
+
+def test_each_joint_has_its_own_acceleration_limit():
+    rate = RateLimits(np.array([10.0, 10.0]), dt=0.1, acceleration=np.array([1.0, 3.0]))
+    np.testing.assert_allclose(rate.box(np.zeros(2), 100 * LOWER, 100 * UPPER)[1], [0.01, 0.03])
+    np.testing.assert_allclose(rate.change, [0.01, 0.03], rtol=1e-8)
+
+
+def test_a_joint_brakes_in_time_for_its_position_limit():
+    # At 1 rad/s toward a limit 0.3 rad away with 2 rad/s²: braking needs 0.25 rad, so the
+    # next motion toward it must leave room to stop: m + m²/(2c) ≤ 0.3 - ..., c = 0.02 rad.
+    rate = RateLimits(np.array([10.0]), dt=0.1, acceleration=2.0)
+    rate.record(np.array([0.1]))
+    high = rate.box(np.array([0.7]), np.array([-1.0]), np.array([1.0]))[1]
+    m = high[0] - 0.7
+    assert m + m**2 / (2 * 0.02) <= 0.3 + 1e-12
+    assert m >= 0.1 - 0.02 - 1e-12  # and it can still brake within the acceleration limit
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.floats(0.0, 1.0), min_size=1, max_size=120), st.floats(0.2, 5.0))
+def test_any_motion_inside_each_box_keeps_every_limit(choices, acceleration):
+    """Whatever point of each period's box is taken, the motion never leaves the position
+    limits, never breaks the speed or acceleration limit, and the box is never empty."""
+    speed, dt = 1.5, 0.05
+    rate = RateLimits(np.array([speed]), dt=dt, acceleration=acceleration)
+    q, last = np.array([0.9]), np.zeros(1)
+    for u in choices:
+        low, high = rate.box(q, LOWER, UPPER)
+        assert not rate.strained
+        q_next = low + u * (high - low)
+        motion = q_next - q
+        assert LOWER[0] - 1e-12 <= q_next[0] <= UPPER[0] + 1e-12
+        assert abs(motion[0]) <= speed * dt * (1 + 1e-9)
+        assert abs(motion[0] - last[0]) <= acceleration * dt**2 * (1 + 1e-9)
+        rate.record(motion)
+        q, last = q_next, motion
+
+
+def test_a_motion_beyond_the_limits_strains_the_box_to_its_nearest_point():
+    rate = RateLimits(np.array([1.0]), dt=0.1, acceleration=1.0)
+    rate.record(np.array([0.5]))  # measured five times faster than the speed limit allows
+    low, high = rate.box(np.zeros(1), LOWER, UPPER)
+    assert rate.strained
+    np.testing.assert_allclose([low[0], high[0]], [0.1, 0.1], rtol=1e-8)
 
 
 @pytest.mark.parametrize("fields", [{"velocity": [0.0, 1.0]}, {"dt": 0.0}, {"acceleration": -1.0}])

@@ -1,4 +1,4 @@
-"""robots/model.py on general URDFs: continuous joints as revolute joints within ±2π, locked
+"""robots/model.py on general URDFs: continuous joints without position limits (wrapped), locked
 joints (a reduced model), mimic joints and an offset tool point, against the small arm's
 hand-written kinematics; every refusal names its field."""
 
@@ -12,25 +12,31 @@ import pytest
 from articula.errors import ConfigError
 from articula.geometry.poses import pose
 from articula.robots import RobotModel
-from articula.robots._urdf_kinematics import CONTINUOUS_LIMIT
 from tests.robots.helpers import rot_y, rot_z, urdf_origin
 from tests.robots.test_model import hand_small_ee
 
 CONTINUOUS_J2 = ('name="j2" type="revolute"', 'name="j2" type="continuous"')
 
 
-def test_continuous_joint_is_a_revolute_joint_within_two_pi(build_edited):
+def test_continuous_joint_has_no_position_limit_and_wraps_the_shortest_way(build_edited):
     robot = build_edited(*CONTINUOUS_J2)
     assert robot.nq == 3 and robot.model.nv == 3
     assert robot.joint_names == ["j1", "j2", "j3"]
-    np.testing.assert_allclose(robot.lower, [-3, -2 * math.pi, 0])
-    np.testing.assert_allclose(robot.upper, [3, 2 * math.pi, 0.2])
-    assert math.isclose(CONTINUOUS_LIMIT, 2 * math.pi)
+    assert robot.continuous.tolist() == [False, True, False]
+    np.testing.assert_allclose(robot.lower, [-3, -np.inf, 0])
+    np.testing.assert_allclose(robot.upper, [3, np.inf, 0.2])
+    np.testing.assert_allclose(robot.sample_range[0], [-3, -math.pi, 0])
     assert robot.velocity_limit[1] == 1.0  # the URDF's <limit velocity="1"> is kept
     for angle in np.linspace(-2 * math.pi, 2 * math.pi, 9):
-        q = (0.4, angle, 0.1)
+        q = np.array([0.4, angle, 0.1])
         np.testing.assert_allclose(robot.ee_position(q), hand_small_ee(q), atol=1e-12)
-        np.testing.assert_allclose(robot.clip(np.array(q)), q)
+        wrapped = robot.wrap(q)
+        assert -math.pi < wrapped[1] <= math.pi and wrapped[[0, 2]].tolist() == [0.4, 0.1]
+        np.testing.assert_allclose(robot.ee_position(wrapped), hand_small_ee(q), atol=1e-12)
+    # 3.1 → -3.1 is a turn of 0.083 rad the short way, not 6.2 rad back.
+    a, b = np.array([0.0, -3.1, 0.0]), np.array([0.0, 3.1, 0.0])
+    np.testing.assert_allclose(robot.difference(a, b), [0.0, 2 * math.pi - 6.2, 0.0])
+    np.testing.assert_allclose(robot.difference(a, b)[[0, 2]], (a - b)[[0, 2]])
 
 
 def test_continuous_joint_without_limit_element_has_no_speed_limit(build_edited):
@@ -41,8 +47,9 @@ def test_continuous_joint_without_limit_element_has_no_speed_limit(build_edited)
         'name="j2" type="continuous">\n    <parent link="link1"/><child link="link2"/>\n'
         '    <origin xyz="0 0 0.3"/><axis xyz="0 1 0"/>',
     )
-    np.testing.assert_allclose(robot.upper, [3, 2 * math.pi, 0.2])
+    np.testing.assert_allclose(robot.upper, [3, np.inf, 0.2])
     assert robot.velocity_limit[1] == np.inf
+    assert robot.acceleration_limit[1] == np.inf  # no speed limit: no acceleration from it
     assert robot.model.effortLimit[1] == np.inf
     q = (0.2, -5.0, 0.0)
     np.testing.assert_allclose(robot.ee_position(q), hand_small_ee(q), atol=1e-12)

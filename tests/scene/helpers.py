@@ -18,10 +18,13 @@ from articula.validation import load_toml
 CONFIGS = Path(__file__).resolve().parents[2] / "src/articula/book/ch1/configs"
 
 
-def book_scene(name: str) -> Scene:
-    """A new Scene built from the chapter-1 scene file `name` (e.g. "circle_two_obstacles")."""
+def book_scene(name: str, self_collision: bool = False) -> Scene:
+    """A new Scene built from the chapter-1 scene file `name` (e.g. "circle_two_obstacles"),
+    by default without self pairs (link-obstacle distances alone)."""
     path = CONFIGS / f"{name}.toml"
-    return build_scene(load_scene_spec(load_toml(path)), path.parent)[0]
+    data = load_toml(path)
+    data["robot"]["self_collision"] = self_collision
+    return build_scene(load_scene_spec(data), path.parent)[0]
 
 
 def one_link_robot(shapes: list[ConvexShape], placements: list[np.ndarray]) -> RobotModel:

@@ -410,7 +410,7 @@ def busy(tmp_path_factory) -> tuple[dict, Path]:
 @pytest.fixture(scope="module")
 def busy_scenes(busy) -> tuple[Scene, Scene]:
     data, folder = busy
-    spec = load_scene_spec(data)
+    spec = load_scene_spec({**data, "robot": {**data["robot"], "self_collision": False}})
     with_bp, _ = build_scene(spec, folder, broadphase=True)
     without, _ = build_scene(spec, folder, broadphase=False)
     return with_bp, without
@@ -418,10 +418,15 @@ def busy_scenes(busy) -> tuple[Scene, Scene]:
 
 @pytest.fixture(scope="module")
 def example_scenes() -> tuple[Scene, Scene]:
-    spec = load_scene_spec(load_toml(TWO_OBSTACLES))
+    data = load_toml(TWO_OBSTACLES)
+    data["robot"]["self_collision"] = False  # link-obstacle distances alone
+    spec = load_scene_spec(data)
     with_bp, _ = build_scene(spec, CONFIGS, broadphase=True)
     without, _ = build_scene(spec, CONFIGS, broadphase=False)
     return with_bp, without
+
+
+NO_SELF = {"builtin": "iiwa14", "self_collision": False}  # link-obstacle distances alone
 
 
 def _random_configurations(robot: RobotModel, n: int, seed: int) -> np.ndarray:
@@ -497,9 +502,9 @@ def _brute_vertex_distances(scene: Scene, q: np.ndarray, t: float) -> np.ndarray
 @pytest.mark.parametrize("which", ["example", "busy"])
 def test_vertex_metric_is_the_brute_force_vertex_minimum(which, busy):
     if which == "example":
-        spec, folder = load_scene_spec(load_toml(TWO_OBSTACLES)), CONFIGS
+        spec, folder = load_scene_spec(load_toml(TWO_OBSTACLES) | {"robot": NO_SELF}), CONFIGS
     else:
-        spec, folder = load_scene_spec(busy[0]), busy[1]
+        spec, folder = load_scene_spec(busy[0] | {"robot": NO_SELF}), busy[1]
     vertex, _ = build_scene(spec, folder, metric="vertex")
     gjk, _ = build_scene(spec, folder, metric="gjk")
     Q = _random_configurations(vertex.robot, 25, seed=4)

@@ -36,7 +36,8 @@ def chromium() -> str:
 
 @pytest.fixture(scope="session")
 def planned_run(tmp_path_factory) -> Path:
-    """A 3 s qp run of the book's two-obstacle circle, written by `articula plan`."""
+    """A qp run of the book's two-obstacle circle, its approach from home and 3 s of the
+    path, written by `articula plan`."""
     folder = tmp_path_factory.mktemp("view")
     config = load_toml(CONFIGS / "circle_two_obstacles.toml")
     for obstacle in config["obstacles"]:

@@ -35,7 +35,8 @@ def plan(
 ) -> None:
     """Track the scene's reference path with its planner; writes a run folder (trace + record).
 
-    A motion with a colliding step still writes its run folder, then exits with status 4.
+    A motion with a colliding step (a link in an obstacle, or two links of a checked pair
+    touching) still writes its run folder, then exits with status 4.
 
     \b
     Example: articula plan src/articula/book/ch1/configs/circle_two_obstacles.toml --out runs/circle
@@ -67,6 +68,14 @@ def plan(
             f"the motion collides in {int(m['collisions'])} steps (deepest "
             f"{-1e3 * m['min_clearance']:.1f} mm); the run folder {out_dir} is written; pass "
             "--allow-collisions to accept it, or raise planner.d_min or lambda_weight"
+        )
+    if m.get("self_collisions") and not allow_collisions:
+        from articula.errors import CollisionError
+
+        raise CollisionError(
+            f"the arm collides with itself in {int(m['self_collisions'])} steps (deepest "
+            f"{-1e3 * m['min_self_clearance']:.1f} mm); the run folder {out_dir} is written; "
+            "pass --allow-collisions to accept it, or raise robot.self_d_min"
         )
 
 

@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import hashlib
-import os
-import tempfile
+import io
 from pathlib import Path
 
 import numpy as np
 import trimesh
 
+from articula.disk_cache import keep, read_cached
 from articula.errors import GeometryError
 from articula.geometry.shapes import ConvexShape, convex_hull
 from articula.limits import MAX_DECOMPOSE_VERTICES, MAX_LENGTH, MAX_SCALE, MIN_SCALE
@@ -111,18 +111,6 @@ def convex_parts(
     return [convex_hull(v, f"{name}[{i}]") for i, v in enumerate(pieces)]
 
 
-def cache_folder() -> Path:
-    """Where convex decompositions are kept: $ARTICULA_CACHE_DIR, else the user's cache.
-
-    Returns:
-        The cache folder (it may not exist yet).
-    """
-    if "ARTICULA_CACHE_DIR" in os.environ:
-        return Path(os.environ["ARTICULA_CACHE_DIR"])
-    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(base) / "articula" / "decompositions"
-
-
 def _cache_key(vertices: np.ndarray, faces: np.ndarray, threshold: float) -> str:
     """A decomposition's name: the mesh's content, the threshold and CoACD's version."""
     import coacd
@@ -134,24 +122,18 @@ def _cache_key(vertices: np.ndarray, faces: np.ndarray, threshold: float) -> str
 
 def _cached(key: str) -> list[np.ndarray] | None:
     """The parts' vertices [m] of a decomposition made before, or None."""
+    data = read_cached(f"{key}.npz")
+    if data is None:
+        return None
     try:
-        with np.load(cache_folder() / f"{key}.npz") as data:
-            return [data[f"part{i}"] for i in range(len(data.files))]
+        with np.load(io.BytesIO(data)) as parts:
+            return [parts[f"part{i}"] for i in range(len(parts.files))]
     except (OSError, ValueError, KeyError):
-        return None  # not there, or unreadable: decompose again
+        return None  # unreadable: decompose again
 
 
 def _store(key: str, pieces: list[np.ndarray]) -> None:
     """Keep a decomposition for next time (written whole, or not at all)."""
-    folder = cache_folder()
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{key}.", suffix=".npz")
-    except OSError:
-        return  # a read-only home: the decomposition is only not kept
-    try:
-        with os.fdopen(fd, "wb") as f:
-            np.savez(f, **{f"part{i}": v for i, v in enumerate(pieces)})
-        os.replace(tmp, folder / f"{key}.npz")
-    except OSError:
-        Path(tmp).unlink(missing_ok=True)
+    buffer = io.BytesIO()
+    np.savez(buffer, **{f"part{i}": v for i, v in enumerate(pieces)})
+    keep(f"{key}.npz", buffer.getvalue())

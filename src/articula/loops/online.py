@@ -4,10 +4,12 @@
 and a planned run share one code path:
 
     controller = OnlineController.from_spec(scene, PlannerSpec(method="qp"), live_obstacles=True)
-    q = controller.reset(q_measured)
+    q = controller.reset(q_measured)        # checks the start, compiles every kernel
     every 10 ms:
-        q = controller.step(target, {"box": pose_from_camera})   # send q to the arm
-    (target: a position [m], a 4×4 pose for a pose task, or a Target)
+        q = controller.step(target, {"box": pose_from_camera}, q_measured=read_joints())
+        send q to the arm
+    (target: a position [m], a 4×4 pose for a pose task, or a Target; without q_measured the
+    controller plans from its own last command)
 """
 
 from __future__ import annotations
@@ -60,6 +62,8 @@ class OnlineController:
     Attributes:
         periods: control periods since reset; the time is periods · dt [s].
         q: the last commanded joint positions, shape (n,) [rad]; None before reset.
+        q_measured: the last measured joint positions (the start after reset), shape (n,)
+            [rad]; None before reset.
         held: the start's tool pose, whose orientation and axis fill in what a target lacks.
         target: the last period's target, completed.
     """
@@ -74,6 +78,7 @@ class OnlineController:
         self.live = dict(live or {})
         self.periods = 0  # since reset; the time is periods · dt [s]
         self.q: np.ndarray | None = None
+        self.q_measured: np.ndarray | None = None
         self.held: Target | None = None  # the start's orientation and tool axis
         self.target: Target | None = None  # the last period's, complete
 
@@ -100,35 +105,45 @@ class OnlineController:
                 live[o.name] = LivePose(o.pose_at(0.0))
                 obstacles.append(Obstacle(o.name, o.parts, live[o.name]))
             scene = Scene(scene.robot, obstacles, scene.broadphase, scene.metric,
-                          scene.self_pair_names)  # fmt: skip
+                          scene.self_pair_names, scene.self_d_min)  # fmt: skip
         return cls(make_planner(spec, scene, seed), spec.dt, live)
 
-    def reset(self, q: Sequence[float] | np.ndarray) -> np.ndarray:
-        """Start from q [rad] at rest, at t = 0, once the start is checked.
+    def reset(
+        self,
+        q: Sequence[float] | np.ndarray,
+        velocity: Sequence[float] | np.ndarray | None = None,
+    ) -> np.ndarray:
+        """Start from q [rad] at t = 0, once the start is checked; every compiled kernel is
+        compiled (or loaded from numba's cache) before this returns, so the first step is as
+        fast as the others.
 
         Args:
             q: the arm's measured joint positions, shape (n,) [rad].
+            velocity: the arm's joint velocities [rad/s], shape (n,), for the acceleration
+                limit of the first step; None: at rest.
 
         Returns:
-            A copy of the checked start, shape (n,) [rad].
+            A copy of the checked start, shape (n,) [rad] (continuous joints wrapped).
 
         Raises:
             InfeasibleError: naming `q0`, for a start outside the joint limits, in collision
-                (with an obstacle or, for a checked link pair, with itself), or within d_min
-                of an obstacle.
+                (with an obstacle or, for a checked link pair, with itself), within d_min of an
+                obstacle or within self_d_min between two links.
         """
         scene, robot = self.planner.scene, self.planner.scene.robot
-        start = robot.check_q(q, "q0").copy()
+        start = robot.wrap(robot.check_q(q, "q0"))
         if np.any(start < robot.lower) or np.any(start > robot.upper):
             raise InfeasibleError("the start breaks the joint limits (Eq. 1.9)", "q0")
         if scene.self_pairs:
             d_self = scene.self_distances(start)
             k = int(np.argmin(d_self))
-            if d_self[k] <= 0:
+            if d_self[k] <= scene.self_d_min:
                 a, b = scene.self_pair_names[k]
+                what = "collides with itself" if d_self[k] <= 0 else "is too close to itself"
                 raise InfeasibleError(
-                    f"the start collides with itself: links {a} and {b} (d = {d_self[k]:.4f} m); "
-                    "move the start or allow the pair in robot.allow_pairs",
+                    f"the start {what}: links {a} and {b} are {d_self[k]:.4f} m apart, within "
+                    f"self_d_min = {scene.self_d_min} m; move the start, lower "
+                    "robot.self_d_min or allow the pair in robot.allow_pairs",
                     "q0",
                 )
         if scene.obstacles:
@@ -141,30 +156,47 @@ class OnlineController:
                     f"{self.planner.d_min} m (Eq. 1.12); lower d_min or move the start",
                     "q0",
                 )
-        self.planner.reset()
-        self.q, self.periods = start, 0
         pose = robot.ee_pose(start)
-        self.held = Target(pose[:3, 3], pose[:3, :3], pose[:3, :3] @ self.planner.task.tool_axis)
+        rotation = np.ascontiguousarray(pose[:3, :3])  # the kernels compile for C-ordered arrays
+        self.held = Target(pose[:3, 3].copy(), rotation, rotation @ self.planner.task.tool_axis)
+        self.planner.warm_up(start, self.held)
+        self.planner.reset()
+        if velocity is not None:
+            moving = robot.check_q(velocity, "velocity")
+            self.planner.follow(moving * self.dt)
+        self.q, self.q_measured, self.periods = start, start.copy(), 0
         return start.copy()
 
     def step(
         self,
         target: Sequence[float] | np.ndarray | Target,
         obstacle_poses: Mapping[str, np.ndarray] | None = None,
+        q_measured: Sequence[float] | np.ndarray | None = None,
     ) -> np.ndarray:
         """One control period toward the target; obstacle_poses moves live obstacles first.
+
+        With q_measured the period plans from the arm's measured joints instead of the last
+        command, and the speed and acceleration limits hold relative to the measured motion
+        (since the last measurement, or the start).
 
         Args:
             target: a position (3,) [m], a pose (4×4, world) or a Target; an orientation or
                 axis the task needs and the target lacks is the start's, held.
             obstacle_poses: live obstacle name -> its new pose (4×4, world) [m]; None: none
                 moves.
+            q_measured: the arm's joint positions measured at the start of the period, shape
+                (n,) [rad]; None: plan from the last command.
 
         Returns:
-            The new joint positions to send to the arm, shape (n,) [rad].
+            The new joint positions to send to the arm, shape (n,) [rad] (continuous joints
+            wrapped to (−π, π]).
         """
-        if self.q is None or self.held is None:
+        if self.q is None or self.held is None or self.q_measured is None:
             raise ConfigError("reset", "call reset(q) with the arm's configuration first")
+        robot = self.planner.scene.robot
+        measured = None
+        if q_measured is not None:
+            measured = robot.wrap(robot.check_q(q_measured, "q_measured"))
         for name, pose in (obstacle_poses or {}).items():
             if name not in self.live:
                 known = ", ".join(sorted(self.live)) or "none (build it with live_obstacles)"
@@ -175,7 +207,10 @@ class OnlineController:
             except GeometryError as exc:
                 raise ConfigError(f"obstacle_poses.{name}", str(exc)) from None
         self.target = self._complete(target)
-        self.q = self.planner.step(self.q, self.target, self.t)
+        if measured is not None:
+            self.planner.follow(robot.difference(measured, self.q_measured))
+            self.q, self.q_measured = measured, measured
+        self.q = robot.wrap(self.planner.step(self.q, self.target, self.t))
         self.periods += 1
         return self.q.copy()
 

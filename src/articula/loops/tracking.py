@@ -11,17 +11,15 @@ import numpy as np
 from articula.errors import ConfigError
 from articula.limits import MAX_STEPS
 from articula.loops.online import OnlineController
+from articula.planning.approach import Trajectory
 from articula.planning.planner import Planner
-from articula.planning.task import Target
 from articula.robots.model import RobotModel
-
-Trajectory = Callable[[float], "np.ndarray | Target"]  # a position [m] or a whole Target
 
 
 @dataclass(frozen=True)
 class PlanResult:
-    """Time series of a tracking run: t [s], q [rad], x and x_ref [m], error and clearance [m]
-    (to obstacles and, with self-collision on, between checked link pairs).
+    """Time series of a tracking run: t [s], q [rad], x and x_ref [m], error [m], clearance to
+    obstacles and between the checked link pairs [m].
 
     Attributes:
         t: time of each control period, shape (k,) [s].
@@ -29,12 +27,17 @@ class PlanResult:
         x: end-effector position, shape (k, 3) [m].
         x_ref: reference position, shape (k, 3) [m].
         error: distance |x − x_ref|, shape (k,) [m].
-        clearance: smallest signed distance each period, shape (k,) [m]; inf: none checked.
+        clearance: smallest link-obstacle signed distance each period, shape (k,) [m]; inf:
+            no obstacle.
         planner_seconds: time spent in planner.step alone after the first period [s].
-        first_period_seconds: the first period's time [s]; it compiles or loads the kernels.
+        first_period_seconds: the first period's time [s].
         q0: the start, shape (n,) [rad]; None: the first step's speed is unknown.
         orientation_error: orientation error, shape (k,) [rad], for a pose or axis task;
             else None.
+        self_clearance: smallest signed distance between the links of a checked pair each
+            period, shape (k,) [m]; None: no pair checked.
+        path_start: when the path begins, after the approach from the tool [s]; 0: at once.
+        infeasible: periods whose step could not keep every constraint (Planner.infeasible).
     """
 
     t: np.ndarray
@@ -43,10 +46,13 @@ class PlanResult:
     x_ref: np.ndarray
     error: np.ndarray
     clearance: np.ndarray
-    planner_seconds: float  # time spent in planner.step alone [s] after the first period
-    first_period_seconds: float = 0.0  # the first period's: it compiles or loads the kernels
-    q0: np.ndarray | None = None  # the start [rad]; None: the first step's speed is unknown
-    orientation_error: np.ndarray | None = None  # [rad] for a pose or axis task, else None
+    planner_seconds: float
+    first_period_seconds: float = 0.0
+    q0: np.ndarray | None = None
+    orientation_error: np.ndarray | None = None
+    self_clearance: np.ndarray | None = None
+    path_start: float = 0.0
+    infeasible: int = 0
 
 
 def track(
@@ -57,6 +63,7 @@ def track(
     duration: float,
     max_steps: int = MAX_STEPS,
     progress: Callable[[int, int], None] | None = None,
+    path_start: float = 0.0,
 ) -> PlanResult:
     """Follow `trajectory` from q0 [rad] for `duration` [s], one step per `dt` [s] of an
     OnlineController, the object a live loop uses.
@@ -69,6 +76,7 @@ def track(
         duration: length of the run [s], at least dt.
         max_steps: most periods allowed; a longer run is refused before anything is allocated.
         progress: called as progress(done, total) every hundredth of the run; None: silent.
+        path_start: when the path itself begins (an Approach's duration) [s].
 
     Returns:
         The run's time series.
@@ -92,6 +100,7 @@ def track(
     x = np.empty((steps, 3))
     x_ref = np.empty((steps, 3))
     clearance = np.full(steps, np.inf)
+    self_clearance = np.full(steps, np.inf) if scene.self_pairs else None
     task = planner.task
     orientation = np.zeros(steps) if task.kind != "position" else None
     planner_seconds = first_period_seconds = 0.0
@@ -113,10 +122,13 @@ def track(
         if orientation is not None:
             orientation[n] = task.orientation_error(pose[:3, :3], controller.target)
         if scene.has_clearance:
-            clearance[n] = scene.min_distance(q, tn)
+            clearance[n], d_self = scene.clearances(q, tn)
+            if self_clearance is not None:
+                self_clearance[n] = d_self
     error = np.linalg.norm(x - x_ref, axis=1)
     return PlanResult(t, qs, x, x_ref, error, clearance, planner_seconds, first_period_seconds,
-                      q_start, orientation)  # fmt: skip
+                      q_start, orientation, self_clearance, path_start,
+                      planner.infeasible)  # fmt: skip
 
 
 def tracking_metrics(
@@ -124,24 +136,28 @@ def tracking_metrics(
 ) -> dict[str, float]:
     """Metrics of a tracking run.
 
-    rms_error and max_error [m] after `settle` [s]; clearance [m] and colliding steps over the
-    whole run and after `settle` (the approach from q0 is the riskiest part); joint-limit
-    violations; planner time per inner iteration (`iterations` in all) and per period [µs],
-    both without the first period, and that period's time (first_period_ms).
+    rms_error and max_error [m] after the path's start plus `settle` [s] (approach_s: when the
+    path started); clearance [m] and colliding steps over the whole run and once settled (the
+    approach from q0 is the riskiest part), between the checked link pairs too
+    (min_self_clearance, self_collisions; None without pairs); joint-limit violations; the
+    largest joint speed and acceleration over their limits (max_speed_ratio,
+    max_acceleration_ratio); the periods that could not keep every constraint
+    (infeasible_steps); planner time per inner iteration (`iterations` in all) and per period
+    [µs], both without the first period, and that period's time (first_period_ms).
     For a pose or axis task also rms_ and max_orientation_error [rad] after `settle`, and with
     a `cone` [rad] the settled steps whose tool axis is outside it (cone_violations).
 
     Args:
         run: the tracking run.
-        robot: the robot, for its joint and speed limits.
-        settle: time after which the run counts as settled [s].
+        robot: the robot, for its joint, speed and acceleration limits.
+        settle: time after the path's start from which the run counts as settled [s].
         iterations: inner iterations (BAORNN) or solver calls (baselines) of the whole run.
         cone: allowed angle of the tool axis from its target [rad]; None: not counted.
 
     Returns:
         Metric name -> value, in the units above (times in [µs] or [ms] as named).
     """
-    settled = run.t >= settle
+    settled = run.t >= run.path_start + settle
     late = run.error[settled]
     timed = (len(run.t) - 1) / len(run.t)  # the share of the iterations after the first period
     outside = (run.q < robot.lower) | (run.q > robot.upper)
@@ -160,8 +176,17 @@ def tracking_metrics(
         "min_clearance_settled": float(run.clearance[settled].min()),
         "collisions": float(np.sum(run.clearance <= 0.0)),
         "collisions_settled": float(np.sum(run.clearance[settled] <= 0.0)),
+        "min_self_clearance": None
+        if run.self_clearance is None
+        else float(run.self_clearance.min()),
+        "self_collisions": None
+        if run.self_clearance is None
+        else float(np.sum(run.self_clearance <= 0.0)),
         "joint_limit_violations": float(np.sum(np.any(outside, axis=1))),
         "max_speed_ratio": max_speed_ratio(run, robot),
+        "max_acceleration_ratio": max_acceleration_ratio(run, robot),
+        "infeasible_steps": float(run.infeasible),
+        "approach_s": run.path_start,
         # The planner alone: BAORNN's inner iterations, or a baseline's periods; the first
         # period, which compiles or loads the numba kernels of a fresh process, on its own.
         "time_per_iteration_us": 1e6 * run.planner_seconds / max(iterations * timed, 1.0),
@@ -172,7 +197,8 @@ def tracking_metrics(
 
 def max_speed_ratio(run: PlanResult, robot: RobotModel) -> float:
     """The largest |q̇_i| / (URDF speed limit of joint i) over the run, q̇ by finite
-    differences of the periods (from q0 when known); joints without a limit do not count.
+    differences of the periods (from q0 when known; a continuous joint the shortest way
+    round); joints without a limit do not count.
 
     Args:
         run: the tracking run.
@@ -184,14 +210,37 @@ def max_speed_ratio(run: PlanResult, robot: RobotModel) -> float:
     q = run.q if run.q0 is None else np.vstack([run.q0, run.q])
     if len(q) < 2 or len(run.t) < 2:
         return 0.0
-    speed = np.abs(np.diff(q, axis=0)) / (run.t[1] - run.t[0])
+    speed = np.abs(robot.difference(q[1:], q[:-1])) / (run.t[1] - run.t[0])
     limit = np.where(robot.velocity_limit > 0, robot.velocity_limit, np.inf)
     return float(np.max(speed / limit))
 
 
+def max_acceleration_ratio(run: PlanResult, robot: RobotModel) -> float:
+    """The largest |q̈_i| / (acceleration limit of joint i) over the run, q̈ by second
+    differences of the periods from rest at q0 (when known; a continuous joint the shortest
+    way round); joints without a limit do not count.
+
+    Args:
+        run: the tracking run.
+        robot: the robot, for its joint acceleration limits.
+
+    Returns:
+        The largest acceleration ratio (above 1: a limit is broken); 0 for fewer than three
+        samples.
+    """
+    q = run.q if run.q0 is None else np.vstack([run.q0, run.q0, run.q])  # at rest before q0
+    if len(q) < 3 or len(run.t) < 2:
+        return 0.0
+    motion = robot.difference(q[1:], q[:-1])
+    acceleration = np.abs(np.diff(motion, axis=0)) / (run.t[1] - run.t[0]) ** 2
+    return float(np.max(acceleration / robot.acceleration_limit))
+
+
 def trace_columns(run: PlanResult) -> dict[str, np.ndarray]:
-    """The run as trace columns: t, q_1..q_m, x, y, z, x_ref, y_ref, z_ref, error, clearance,
-    and orientation_error [rad] for a pose or axis task.
+    """The run as trace columns: t, phase ("approach" before the path starts, then "path"),
+    q_1..q_m, x, y, z, x_ref, y_ref, z_ref, error, clearance (link-obstacle),
+    self_clearance (with checked link pairs) and orientation_error [rad] for a pose or axis
+    task.
 
     Args:
         run: the tracking run.
@@ -199,11 +248,13 @@ def trace_columns(run: PlanResult) -> dict[str, np.ndarray]:
     Returns:
         Column name -> its values, shape (k,), in the units of PlanResult.
     """
-    columns = {"t": run.t}
+    columns = {"t": run.t, "phase": np.where(run.t < run.path_start, "approach", "path")}
     columns.update({f"q_{j + 1}": run.q[:, j] for j in range(run.q.shape[1])})
     columns.update({"x": run.x[:, 0], "y": run.x[:, 1], "z": run.x[:, 2]})
     columns.update({"x_ref": run.x_ref[:, 0], "y_ref": run.x_ref[:, 1], "z_ref": run.x_ref[:, 2]})
     columns.update({"error": run.error, "clearance": run.clearance})
+    if run.self_clearance is not None:
+        columns["self_clearance"] = run.self_clearance
     if run.orientation_error is not None:
         columns["orientation_error"] = run.orientation_error
     return columns

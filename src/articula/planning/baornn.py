@@ -10,7 +10,7 @@ import numpy as np
 from pydantic import Field
 
 from articula.planning import baornn_kernel as kernel
-from articula.planning.objective import Box, Objective
+from articula.planning.objective import NO_STOP, Box, Objective, Stop
 from articula.planning.rate_limits import RateLimits
 from articula.planning.task import Target, Task, as_target
 from articula.scene.scene import Scene
@@ -40,34 +40,92 @@ class BeetleSearch:
         objective: the objective g of Eq. (1.13) searched, with its scene and task.
         params: the step constants of Algorithm 1.
         rng: the generator of all the search's randomness (seed it for a reproducible run).
-        rate: joint speed (and acceleration) limits; None: unlimited, as in the book.
+        rate: joint speed and acceleration limits; None: unlimited, as in the book.
         evaluations: objective evaluations so far.
         iterations: iterations of Algorithm 1 so far.
+        infeasible: periods that ended outside Ω (closer than d_min or self_d_min: the limits
+            left no way out) or whose limits could not all hold (RateLimits.strained).
     """
 
     objective: Objective
     params: BaornnParams
     rng: np.random.Generator
-    rate: RateLimits | None = None  # joint speed (and acceleration) limits; None: the book's
+    rate: RateLimits | None = None
     evaluations: int = field(default=0, init=False)
     iterations: int = field(default=0, init=False)
+    infeasible: int = field(default=0, init=False)
     _box: Box | None = field(default=None, init=False, repr=False)  # this period's reach
+    _stop: Stop = field(default=NO_STOP, init=False, repr=False)  # its braking check
 
     def reset(self) -> None:
         """Forget the previous periods: the arm starts at rest."""
         if self.rate is not None:
             self.rate.reset()
 
-    def _begin_period(self, q: np.ndarray) -> None:
-        """Narrow the search of this period to what the joint speed limits let it reach."""
-        if self.rate is not None:
-            robot = self.objective.scene.robot
-            self._box = self.rate.box(q, robot.lower, robot.upper)
+    def warm_up(self, q: np.ndarray, target: Target) -> None:
+        """Compile (or load) the kernels of a step by taking one; the counts and the random
+        state are put back (reset() forgets the step's motion).
 
-    def _end_period(self, start: np.ndarray, q: np.ndarray) -> np.ndarray:
-        """Remember the period's motion for the acceleration limit; returns q."""
+        Args:
+            q: a configuration to step from, shape (nq,) [rad].
+            target: a target to step toward.
+        """
+        state = self.rng.bit_generator.state
+        counts = (self.evaluations, self.iterations, self.infeasible)
+        self.step(q.copy(), target, 0.0)
+        self.rng.bit_generator.state = state
+        self.evaluations, self.iterations, self.infeasible = counts
+
+    def follow(self, motion: np.ndarray) -> None:
+        """Take the arm's measured joint motion [rad] over the period that ended as its motion:
+        the next period's limits hold relative to it.
+
+        Args:
+            motion: the measured joint displacement over the last period, shape (nq,) [rad].
+        """
+        if self.rate is not None:
+            self.rate.record(motion)
+
+    def _begin_period(
+        self, q: np.ndarray, target: Target, t: float
+    ) -> tuple[np.ndarray, float] | None:
+        """Narrow this period's search to what the joint limits let it reach, and start it at
+        the better of braking (the point of that box nearest q) and coasting (q plus the last
+        motion), g = inf outside Ω; None without limits (the book's start at q)."""
+        if not self._limit_period(q):
+            return None
+        obj = self.objective
+        brake = np.clip(q, *self._box)
+        start = obj.project_and_value(brake, brake, math.inf, target, t, (brake, brake),
+                                      self._stop)  # fmt: skip
+        self.evaluations += 1
+        last = self.rate.last_motion
+        if last is not None:
+            coast = obj.project_and_value(q + last, brake, math.inf, target, t, self._box,
+                                          self._stop)  # fmt: skip
+            self.evaluations += 1
+            if coast[1] < start[1]:
+                start = coast
+        return start
+
+    def _limit_period(self, q: np.ndarray) -> bool:
+        """Set this period's box and braking check from q [rad]; False without limits."""
+        if self.rate is None:
+            self._box, self._stop = None, NO_STOP
+            return False
+        robot = self.objective.scene.robot
+        self._box = self.rate.box(q, robot.lower, robot.upper)
+        change = self.rate.change
+        self._stop = NO_STOP if change is None else Stop(q, change, self.objective.sweep)
+        return True
+
+    def _end_period(self, start: np.ndarray, q: np.ndarray, g: float) -> np.ndarray:
+        """Remember the period's motion for the acceleration limit, count it when it ended
+        outside Ω (g = inf) or its limits were strained; returns q."""
         if self.rate is not None:
             self.rate.record(q - start)
+            if self.rate.strained or not math.isfinite(g):
+                self.infeasible += 1
         return q
 
     @property
@@ -93,9 +151,10 @@ class Baornn(BeetleSearch):
         objective: the objective g of Eq. (1.13) searched, with its scene and task.
         params: the step constants of Algorithm 1.
         rng: the generator of all the search's randomness (seed it for a reproducible run).
-        rate: joint speed (and acceleration) limits; None: unlimited, as in the book.
+        rate: joint speed and acceleration limits; None: unlimited, as in the book.
         evaluations: objective evaluations so far.
         iterations: iterations of Algorithm 1 so far.
+        infeasible: periods that ended outside Ω or whose limits could not all hold.
     """
 
     def iterate(
@@ -120,15 +179,17 @@ class Baornn(BeetleSearch):
             self.iterations += 1
             return kernel.iterations(q, g, target.position, obj.orient_arguments(target),
                                      b[None, :], self.params.c1, self.params.c2,
-                                     *obj.kernel_arguments(self._box, t))  # fmt: skip
+                                     *obj.kernel_arguments(self._box, t, self._stop))  # fmt: skip
         b /= math.sqrt(b @ b)  # a normalised random direction
         lam = self.params.c1 * np.sqrt(g) if np.isfinite(g) else self.params.c1  # Eq. (1.23)
         # Eqs. (1.15)-(1.18): antennae, projected onto Ω, evaluated by "virtual robots".
-        _, g_left = obj.project_and_value(q + lam * b, q, g, target, t, self._box)
-        _, g_right = obj.project_and_value(q - lam * b, q, g, target, t, self._box)
+        _, g_left = obj.project_and_value(q + lam * b, q, g, target, t, self._box, self._stop)
+        _, g_right = obj.project_and_value(q - lam * b, q, g, target, t, self._box, self._stop)
         delta = self.params.c2 * lam  # Eq. (1.24)
         step = q - delta * np.sign(g_left - g_right) * b  # Eq. (1.19)
-        q_new, g_new = obj.project_and_value(step, q, g, target, t, self._box)  # Eq. (1.20)
+        q_new, g_new = obj.project_and_value(
+            step, q, g, target, t, self._box, self._stop
+        )  # Eq. (1.20)
         self.evaluations += 3
         self.iterations += 1
         if g_new < g:  # Eqs. (1.21)-(1.22): accept only an improvement
@@ -148,17 +209,17 @@ class Baornn(BeetleSearch):
         """
         target = as_target(target)
         obj, k, start = self.objective, self.params.iterations_per_step, q
-        self._begin_period(q)
-        g = obj.value(q, target, t)
+        begun = self._begin_period(q, target, t)
+        q, g = (q, obj.value(q, target, t)) if begun is None else begun
         if obj.compiled is not None:
             # The same draws as k calls of iterate: the Generator fills rows in order.
             directions = self.rng.standard_normal((k, q.size))
             self.evaluations += 3 * k
             self.iterations += k
-            q, _ = kernel.iterations(q, g, target.position, obj.orient_arguments(target),
+            q, g = kernel.iterations(q, g, target.position, obj.orient_arguments(target),
                                      directions, self.params.c1, self.params.c2,
-                                     *obj.kernel_arguments(self._box, t))  # fmt: skip
-            return self._end_period(start, q)
+                                     *obj.kernel_arguments(self._box, t, self._stop))  # fmt: skip
+            return self._end_period(start, q, g)
         for _ in range(k):
             q, g = self.iterate(q, g, target, t)
-        return self._end_period(start, q)
+        return self._end_period(start, q, g)

@@ -51,9 +51,10 @@ class ImprovedBaornn(BeetleSearch):
         objective: the objective g of Eq. (1.13) searched, with its scene and task.
         params: the step constants, with the antenna pairs.
         rng: the generator of all the search's randomness (seed it for a reproducible run).
-        rate: joint speed (and acceleration) limits; None: unlimited, as in the book.
+        rate: joint speed and acceleration limits; None: unlimited, as in the book.
         evaluations: objective evaluations so far.
         iterations: iterations of Algorithm 1 so far.
+        infeasible: periods that ended outside Ω or whose limits could not all hold.
     """
 
     params: ImprovedParams
@@ -87,8 +88,10 @@ class ImprovedBaornn(BeetleSearch):
             scale = kernel.antenna_scale(j, p.short_antenna)
             length = scale * lam
             # Eq. (1.15): the two antennae.
-            q_left, g_left = obj.project_and_value(q + length * b, q, g, target, t, self._box)
-            q_right, g_right = obj.project_and_value(q - length * b, q, g, target, t, self._box)
+            q_left, g_left = obj.project_and_value(q + length * b, q, g, target, t, self._box,
+                                                   self._stop)  # fmt: skip
+            q_right, g_right = obj.project_and_value(q - length * b, q, g, target, t, self._box,
+                                                     self._stop)  # fmt: skip
             if np.isfinite(g_left) and np.isfinite(g_right):
                 # A difference over a shorter antenna counts as much per unit length.
                 gradient += (g_left - g_right) / scale * b
@@ -99,7 +102,7 @@ class ImprovedBaornn(BeetleSearch):
         self.evaluations += 2 * directions.shape[0]
         if norm > 0:
             step = q - p.c2 * lam * gradient / norm  # Eq. (1.19) along the estimated gradient
-            q_new, g_new = obj.project_and_value(step, q, g, target, t, self._box)
+            q_new, g_new = obj.project_and_value(step, q, g, target, t, self._box, self._stop)
             self.evaluations += 1
             if g_new < best_g:  # Eqs. (1.21)-(1.22): only an improvement is accepted
                 best_q, best_g = q_new, g_new
@@ -110,6 +113,16 @@ class ImprovedBaornn(BeetleSearch):
         """Forget the previous periods: no warm start, the arm at rest."""
         super().reset()
         self._last_motion = None
+
+    def follow(self, motion: np.ndarray) -> None:
+        """Take the arm's measured joint motion [rad] over the period that ended as its motion:
+        the next period's limits and warm start start from it.
+
+        Args:
+            motion: the measured joint displacement over the last period, shape (nq,) [rad].
+        """
+        super().follow(motion)
+        self._last_motion = np.array(motion, dtype=float)
 
     def step(self, q: np.ndarray, target: Target | np.ndarray, t: float) -> np.ndarray:
         """One control period: warm start, then iterate.
@@ -124,18 +137,28 @@ class ImprovedBaornn(BeetleSearch):
         """
         target = as_target(target)
         start = q
-        self._begin_period(q)
         p = self.params
         if self.objective.compiled is not None:
+            # With limits the period starts where braking as hard as they allow takes it (g =
+            # inf outside Ω), and coasting, q plus the last motion, is the warm start.
+            warm = self._last_motion
+            if self._limit_period(q):
+                q = np.clip(q, *self._box)
+                warm = None if warm is None else start + warm - q
             # The same draws as iterations_per_step calls of iterate, in one compiled call.
             draws = self.rng.standard_normal((p.iterations_per_step, q.size, min(p.pairs, q.size)))
-            warm = np.zeros(0) if self._last_motion is None else self._last_motion
-            q, _ = self._compiled(q, math.nan, warm, target, draws, t)
+            q, g = self._compiled(
+                q, math.nan, np.zeros(0) if warm is None else warm, target, draws, t
+            )
         else:
-            g = self.objective.value(q, target, t)
-            if self._last_motion is not None:
+            # With limits the period starts at the better of braking and coasting, which is
+            # the warm start; without, at q with the warm start tried first.
+            begun = self._begin_period(q, target, t)
+            warm = self._last_motion if begun is None else None
+            q, g = (q, self.objective.value(q, target, t)) if begun is None else begun
+            if warm is not None:
                 q_warm, g_warm = self.objective.project_and_value(
-                    q + self._last_motion, q, g, target, t, self._box
+                    q + warm, q, g, target, t, self._box
                 )
                 self.evaluations += 1
                 if g_warm < g:
@@ -143,7 +166,7 @@ class ImprovedBaornn(BeetleSearch):
             for _ in range(p.iterations_per_step):
                 q, g = self.iterate(q, g, target, t)
         self._last_motion = q - start
-        return self._end_period(start, q)
+        return self._end_period(start, q, g)
 
     def _compiled(
         self,
@@ -154,15 +177,13 @@ class ImprovedBaornn(BeetleSearch):
         draws: np.ndarray,
         t: float,
     ) -> tuple[np.ndarray, float]:
-        """From q with g = g(q) (NaN: computed there), a warm start (none when `warm` is empty)
-        and the iterations of `draws` by planning/baornn_kernel.py, moving obstacles at time t."""
+        """From q with g = g(q) (NaN: computed there, inf outside Ω), a warm start (none when
+        `warm` is empty) and the iterations of `draws` by planning/baornn_kernel.py, moving
+        obstacles at time t."""
         obj, p = self.objective, self.params
-        lambda_weight, beta, d_min, lower, upper, arrays, static_min = obj.kernel_arguments(
-            self._box, t
-        )
         q, g, evaluations = kernel.improved_period(
             q, g, warm, target.position, obj.orient_arguments(target), draws, p.c1, p.c2,
-            p.short_antenna, lambda_weight, beta, d_min, lower, upper, arrays, static_min,
+            p.short_antenna, *obj.kernel_arguments(self._box, t, self._stop),
         )  # fmt: skip
         self.evaluations += evaluations
         self.iterations += draws.shape[0]

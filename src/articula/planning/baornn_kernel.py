@@ -23,20 +23,21 @@ SELF_CONTACT_MARGIN = 1e-4
 
 
 @jit()
-def outside_omega(d: float, d_self: float, d_min: float) -> bool:
-    """Whether a point is outside Ω: not d > d_min (1.12), or its self clearance within
-    SELF_CONTACT_MARGIN (clearances are 0 on overlap, so d_min = 0 still rejects a point inside
-    an obstacle).
+def outside_omega(d: float, d_self: float, d_min: float, self_d_min: float) -> bool:
+    """Whether a point is outside Ω: not d > d_min (1.12), or its self clearance not above
+    self_d_min, and never within SELF_CONTACT_MARGIN (clearances are 0 on overlap, so d_min = 0
+    still rejects a point inside an obstacle).
 
     Args:
         d: the point's smallest link-obstacle clearance [m].
         d_self: its smallest clearance between link pairs that count [m].
         d_min: the hard clearance of Eq. (1.12) [m].
+        self_d_min: the hard clearance between the links of a checked pair [m].
 
     Returns:
         True when the projection must keep the current point.
     """
-    return d <= d_min or d_self <= SELF_CONTACT_MARGIN
+    return d <= d_min or d_self <= max(self_d_min, SELF_CONTACT_MARGIN)
 
 
 @jit()
@@ -52,16 +53,58 @@ def _task_error(ee, ee_R, x_ref, orient):  # fmt: skip
 
 
 @jit()
+def stoppable(clipped, d, d_self, d_min, self_d_min, stop, arrays, static_min):  # fmt: skip
+    """Whether the arm, at `clipped` after this period's motion from stop's q_base, still ends
+    in Ω if every joint then brakes at its largest deceleration (the point where it stops is
+    evaluated only when the clearances left could be used up on the way).
+
+    Args:
+        clipped: the configuration at the end of the period, shape (nq,) [rad].
+        d: its link-obstacle clearance [m].
+        d_self: its clearance between checked link pairs [m].
+        d_min: the hard clearance of Eq. (1.12) [m].
+        self_d_min: the hard clearance between the links of a checked pair [m].
+        stop: (q_base, the period's start, shape (nq,) [rad]; change, each joint's largest
+            change of motion per period, shape (nq,) [rad], empty: no acceleration limit;
+            sweep, how far a shape point moves at most per unit of each joint's motion, shape
+            (nq,) [m/rad]).
+        arrays: compiled scene arrays with the pairs that count (CompiledClearance.arrays).
+        static_min: smallest distance of the pairs that never move, per kind, shape (2,) [m].
+
+    Returns:
+        True when braking from `clipped` stays clear (or there is no acceleration limit).
+    """
+    q_base, change, sweep = stop
+    if change.size == 0:
+        return True
+    q_stop = clipped.copy()
+    travel = 0.0  # [m] the farthest any point of the arm moves while braking
+    for j in range(clipped.size):
+        if math.isfinite(change[j]):
+            m = clipped[j] - q_base[j]
+            q_stop[j] += m * abs(m) / (2.0 * change[j])  # m + (m - c) + ... ≤ m²/(2c) beyond
+            travel += sweep[j] * abs(q_stop[j] - clipped[j])
+    room = min(d - d_min, d_self - max(self_d_min, SELF_CONTACT_MARGIN))
+    if room > travel:
+        return True
+    d_stop, d_self_stop, _, _ = _evaluate(q_stop, *arrays, static_min)
+    return not outside_omega(d_stop, d_self_stop, d_min, self_d_min)
+
+
+@jit()
 def _project_and_value(
-    q, q_current, g_current, e_current, x_ref, orient, lambda_weight, beta, d_min, lower, upper,
-    arrays, static_min,
+    q, q_current, g_current, e_current, x_ref, orient, lambda_weight, beta, d_min, self_d_min,
+    lower, upper, stop, arrays, static_min,
 ):  # fmt: skip
     """(P_Ω(q), g there, the task error e there), Eqs. (1.17)-(1.18); stays at (q_current,
-    g_current, e_current) when the clipped point is outside Ω (outside_omega). The pairs in
-    `arrays` are the ones that count (an obstacle clearance of +inf: none)."""
+    g_current, e_current) when the clipped point is outside Ω (outside_omega) or, with
+    acceleration limits, cannot brake inside it (stoppable). The pairs in `arrays` are the
+    ones that count (an obstacle clearance of +inf: none)."""
     clipped = np.minimum(np.maximum(q, lower), upper)
     d, d_self, ee, ee_R = _evaluate(clipped, *arrays, static_min)
-    if outside_omega(d, d_self, d_min):
+    if outside_omega(d, d_self, d_min, self_d_min) or not stoppable(
+        clipped, d, d_self, d_min, self_d_min, stop, arrays, static_min
+    ):
         return q_current, g_current, e_current
     e = _task_error(ee, ee_R, x_ref, orient)  # Eq. (1.5), with the orientation term
     return clipped, _penalised(e, d, lambda_weight, beta), e
@@ -77,8 +120,8 @@ def _penalised(e, d, lambda_weight, beta):  # fmt: skip
 
 @jit()
 def iterations(
-    q, g, x_ref, orient, directions, c1, c2, lambda_weight, beta, d_min, lower, upper,
-    arrays, static_min,
+    q, g, x_ref, orient, directions, c1, c2, lambda_weight, beta, d_min, self_d_min,
+    lower, upper, stop, arrays, static_min,
 ):  # fmt: skip
     """Run one iteration of Algorithm 1 per row of `directions`; returns the accepted (q, g).
 
@@ -93,8 +136,10 @@ def iterations(
         lambda_weight: penalty weight Λ of Eq. (1.7) [m^(1+β)].
         beta: penalty exponent β of Eq. (1.7).
         d_min: hard clearance of Eq. (1.12) [m].
+        self_d_min: hard clearance between the links of a checked pair [m].
         lower: lower bound of the projection box, shape (nq,) [rad].
         upper: upper bound of the projection box, shape (nq,) [rad].
+        stop: the braking check's (q_base, change, reach), see `stoppable`.
         arrays: compiled scene arrays with the pairs that count (CompiledClearance.arrays).
         static_min: smallest distance of the pairs that never move, per kind, shape (2,) [m].
 
@@ -105,20 +150,40 @@ def iterations(
         b = directions[k] / math.sqrt(directions[k] @ directions[k])
         lam = c1 * math.sqrt(g) if math.isfinite(g) else c1  # Eq. (1.23)
         _, g_left, _ = _project_and_value(q + lam * b, q, g, 0.0, x_ref, orient, lambda_weight,
-                                          beta, d_min, lower, upper, arrays,
+                                          beta, d_min, self_d_min, lower, upper, stop, arrays,
                                           static_min)  # fmt: skip
         _, g_right, _ = _project_and_value(q - lam * b, q, g, 0.0, x_ref, orient, lambda_weight,
-                                           beta, d_min, lower, upper, arrays,
+                                           beta, d_min, self_d_min, lower, upper, stop, arrays,
                                            static_min)  # fmt: skip
         diff = g_left - g_right
         sign = 1.0 if diff > 0.0 else (-1.0 if diff < 0.0 else 0.0)  # 0 when both are inf
         step = q - c2 * lam * sign * b  # Eqs. (1.19), (1.24)
         q_new, g_new, _ = _project_and_value(step, q, g, 0.0, x_ref, orient, lambda_weight,
-                                             beta, d_min, lower, upper, arrays,
+                                             beta, d_min, self_d_min, lower, upper, stop, arrays,
                                              static_min)  # fmt: skip
         if g_new < g:  # Eqs. (1.21)-(1.22)
             q, g = q_new, g_new
     return q, g
+
+
+@jit()
+def antenna_cap(lower: np.ndarray, upper: np.ndarray) -> float:
+    """The longest antenna [rad] worth its evaluations in the box [lower, upper]: half its
+    diagonal (a longer one is clipped back onto the box's faces, and its difference then
+    says little about the gradient); inf for an unbounded box.
+
+    Args:
+        lower: lower bound of the projection box, shape (nq,) [rad].
+        upper: upper bound of the projection box, shape (nq,) [rad].
+
+    Returns:
+        The largest antenna length [rad].
+    """
+    total = 0.0
+    for j in range(lower.size):
+        span = upper[j] - lower[j]
+        total += span * span
+    return 0.5 * math.sqrt(total)
 
 
 @jit()
@@ -149,11 +214,12 @@ def _orthonormal_columns(draw):  # fmt: skip
 
 @jit()
 def improved_period(
-    q, g_known, warm_motion, x_ref, orient, draws, c1, c2, short, lambda_weight, beta, d_min, lower,
-    upper, arrays, static_min,
+    q, g_known, warm_motion, x_ref, orient, draws, c1, c2, short, lambda_weight, beta, d_min,
+    self_d_min, lower, upper, stop, arrays, static_min,
 ):  # fmt: skip
     """One control period of baornn-improved (planning/baornn_improved.py): g at q for the
-    new reference (g_known instead when it is not NaN: a caller's g(q)), the warm start
+    new reference (inf outside Ω; g_known instead when it is not NaN: a caller's g(q)), the warm
+    start
     q + warm_motion (none when it is empty), then one iteration per draws[k], an
     (n × pairs) Gaussian matrix whose orthonormalised columns are the antenna directions.
 
@@ -170,8 +236,10 @@ def improved_period(
         lambda_weight: penalty weight Λ of Eq. (1.7) [m^(1+β)].
         beta: penalty exponent β of Eq. (1.7).
         d_min: hard clearance of Eq. (1.12) [m].
+        self_d_min: hard clearance between the links of a checked pair [m].
         lower: lower bound of the projection box, shape (nq,) [rad].
         upper: upper bound of the projection box, shape (nq,) [rad].
+        stop: the braking check's (q_base, change, reach), see `stoppable`.
         arrays: compiled scene arrays with the pairs that count (CompiledClearance.arrays).
         static_min: smallest distance of the pairs that never move, per kind, shape (2,) [m].
 
@@ -179,20 +247,26 @@ def improved_period(
         The accepted joint angles, shape (nq,) [rad], their objective g, and the number of
         objective evaluations.
     """
-    d, _, ee, ee_R = _evaluate(q, *arrays, static_min)
+    d, d_self, ee, ee_R = _evaluate(q, *arrays, static_min)
     e = _task_error(ee, ee_R, x_ref, orient)
     g = _penalised(e, d, lambda_weight, beta) if math.isnan(g_known) else g_known
+    if math.isnan(g_known) and (
+        outside_omega(d, d_self, d_min, self_d_min)
+        or not stoppable(q, d, d_self, d_min, self_d_min, stop, arrays, static_min)
+    ):
+        g = math.inf  # a start outside Ω: any point inside it is better
     evaluations = 0
     if warm_motion.size:
         q_warm, g_warm, e_warm = _project_and_value(q + warm_motion, q, g, e, x_ref, orient,
-                                                    lambda_weight, beta, d_min, lower, upper,
-                                                    arrays, static_min)  # fmt: skip
+                                                    lambda_weight, beta, d_min, self_d_min, lower,
+                                                    upper, stop, arrays, static_min)  # fmt: skip
         evaluations += 1
         if g_warm < g:
             q, g, e = q_warm, g_warm, e_warm
     n = q.size
+    cap = antenna_cap(lower, upper)
     for k in range(draws.shape[0]):
-        lam = c1 * math.sqrt(e)  # c1·√e_k, e_k the task error at the accepted q
+        lam = min(c1 * math.sqrt(e), cap)  # c1·√e_k, e_k the task error at the accepted q
         directions = _orthonormal_columns(draws[k])
         gradient = np.zeros(n)
         best_q, best_g, best_e = q, g, e
@@ -200,11 +274,11 @@ def improved_period(
             b = directions[j]
             scale = antenna_scale(j, short)
             q_left, g_left, e_left = _project_and_value(
-                q + scale * lam * b, q, g, e, x_ref, orient, lambda_weight, beta, d_min, lower,
-                upper, arrays, static_min)  # fmt: skip
+                q + scale * lam * b, q, g, e, x_ref, orient, lambda_weight, beta, d_min,
+                self_d_min, lower, upper, stop, arrays, static_min)  # fmt: skip
             q_right, g_right, e_right = _project_and_value(
-                q - scale * lam * b, q, g, e, x_ref, orient, lambda_weight, beta, d_min, lower,
-                upper, arrays, static_min)  # fmt: skip
+                q - scale * lam * b, q, g, e, x_ref, orient, lambda_weight, beta, d_min,
+                self_d_min, lower, upper, stop, arrays, static_min)  # fmt: skip
             evaluations += 2
             if math.isfinite(g_left) and math.isfinite(g_right):
                 gradient += (g_left - g_right) / scale * b
@@ -216,8 +290,8 @@ def improved_period(
         if norm > 0.0:
             step = q - c2 * lam * gradient / norm  # Eq. (1.19) along the estimated gradient
             q_new, g_new, e_new = _project_and_value(step, q, g, e, x_ref, orient, lambda_weight,
-                                                     beta, d_min, lower, upper, arrays,
-                                                     static_min)  # fmt: skip
+                                                     beta, d_min, self_d_min, lower, upper, stop,
+                                                     arrays, static_min)  # fmt: skip
             evaluations += 1
             if g_new < best_g:  # Eqs. (1.21)-(1.22)
                 best_q, best_g, best_e = q_new, g_new, e_new

@@ -43,7 +43,7 @@ from articula.validation import (
 )
 
 Method = Literal["baornn", "baornn-improved", "pinv", "dls", "qp"]
-ACCELERATION_METHODS = ("baornn", "baornn-improved")  # the methods max_acceleration limits
+Limits = Literal["velocity+acceleration", "velocity", "none"]
 Rpy = Annotated[list[Radians], Field(min_length=3, max_length=3)]
 Quaternion = Annotated[list[Finite], Field(min_length=4, max_length=4)]
 
@@ -112,8 +112,7 @@ class TrajectorySpec(StrictModel):
 
 
 class PlannerSpec(StrictModel):
-    """[planner]: the method and its parameters; keys a method does not use are ignored,
-    except max_acceleration, which only the BAORNN methods honour and the others refuse.
+    """[planner]: the method and its parameters; keys a method does not use are ignored.
 
     Attributes:
         method: "baornn", "baornn-improved", or the baselines "pinv", "dls" and "qp".
@@ -125,6 +124,8 @@ class PlannerSpec(StrictModel):
         duration: length of the run [s].
         settle: time before rms_error and max_error are measured; default min(5, T/2) [s].
         tolerance: rms_error above which the path counts as not tracked [m].
+        orientation_tolerance: rms_orientation_error above which a pose or axis task counts
+            as not tracked [rad].
         c1: antenna length constant of Eq. (1.23), BAORNN [rad/√m].
         c2: step constant of Eq. (1.24), BAORNN.
         pairs: antenna pairs per iteration, baornn-improved.
@@ -137,11 +138,19 @@ class PlannerSpec(StrictModel):
         seed: seed of the planner's randomness; also accepted at the top of a plan config,
             where it wins (see PlanConfig).
         max_steps: most control periods a run may have (duration / dt).
-        limits: "velocity": the URDF's joint speed limits, scaled; "none": BAORNN moves as
-            fast as the book's Algorithm 1 (the baselines' solvers always keep them).
+        limits: "velocity+acceleration": the URDF's joint speed limits (scaled) and the
+            robot's acceleration limits ([robot] acceleration_limits or accel_time), relative
+            to the last period's motion; "velocity": the speed limits alone; "none": BAORNN
+            moves as fast as the book's Algorithm 1 (the baselines' solvers always keep the
+            speed limits).
         velocity_scale: fraction of the URDF joint speed limits, in (0, 1].
-        max_acceleration: joint acceleration limit for every joint (baornn and
-            baornn-improved only); None: none [rad/s²].
+        max_acceleration: one acceleration limit for every joint that overrides the robot's
+            (limits = "velocity+acceleration" only); None: the robot's [rad/s²].
+        approach: "auto": when the path starts away from the tool, the reference first moves
+            from the tool to the path's start (the approach), then the path begins; "none":
+            the path begins at once, as in the book.
+        approach_speed: the approach's peak tool speed [m/s].
+        approach_turn_rate: the approach's peak tool turn rate (pose and axis tasks) [rad/s].
         task: what the end effector tracks: "position", "pose" or "position+axis"; without
             an orientation or axis in the trajectory, the start's is held.
         orientation_weight: BAORNN's weight on the orientation error [m/rad].
@@ -157,6 +166,7 @@ class PlannerSpec(StrictModel):
     duration: Positive = 50.0  # [s]
     settle: NonNegative | None = None  # [s] before rms_error and max_error; default min(5, T/2)
     tolerance: Positive = 0.05  # [m] an rms_error above it means the path was not tracked
+    orientation_tolerance: Annotated[float, Field(gt=0, le=np.pi, allow_inf_nan=False)] = 0.05
     c1: Positive = 0.5
     c2: Positive = 0.5
     pairs: Annotated[int, Field(ge=1, le=64)] = 3
@@ -168,11 +178,12 @@ class PlannerSpec(StrictModel):
     safety: NonNegative = 0.03
     seed: Seed | None = None
     max_steps: Annotated[int, Field(ge=1, le=10**9)] = MAX_STEPS  # refuse longer runs
-    # Joint speed limits: the URDF's, scaled; "none" lets BAORNN move as fast as the book's
-    # Algorithm 1 does (the baselines' solvers always keep them).
-    limits: Literal["velocity", "none"] = "velocity"
+    limits: Limits = "velocity+acceleration"
     velocity_scale: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 1.0
-    max_acceleration: Positive | None = None  # [rad/s²] every joint, BAORNN only; None: none
+    max_acceleration: Positive | None = None
+    approach: Literal["auto", "none"] = "auto"
+    approach_speed: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)] = 0.25
+    approach_turn_rate: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)] = 0.5
     # What the end effector tracks (beyond the book's position): the trajectory's orientation
     # or tool axis; without one given, the start's is held.
     task: TaskKind = "position"
@@ -193,11 +204,11 @@ class PlannerSpec(StrictModel):
             object.__setattr__(self, "settle", min(5.0, self.duration / 2))
         if self.settle >= self.duration:
             raise field_error("settle", f"must be shorter than duration = {self.duration} s")
-        if self.max_acceleration is not None and self.method not in ACCELERATION_METHODS:
+        if self.max_acceleration is not None and self.limits != "velocity+acceleration":
             raise field_error(
                 "max_acceleration",
-                f"only baornn and baornn-improved limit joint acceleration, not {self.method}; "
-                "remove it or choose one of them",
+                f"limits = {self.limits!r} keeps no acceleration limit; remove max_acceleration "
+                'or set limits = "velocity+acceleration"',
             )
         return self
 
@@ -237,29 +248,36 @@ def _planner(spec: PlannerSpec, scene: Scene, seed: int) -> Planner:
     if spec.method == "qp":
         qp = QpIkParams(gain=spec.gain, influence=spec.influence, safety=spec.safety,
                         speed_scale=spec.velocity_scale)  # fmt: skip
-        return QpIk(scene, spec.dt, qp, spec.d_min, task)
+        return QpIk(scene, spec.dt, qp, spec.d_min, task, rate=rate)
     velocity = VelocityIkParams(
         gain=spec.gain, damping=spec.damping, repulsion=spec.repulsion, influence=spec.influence,
         speed_scale=spec.velocity_scale,
     )  # fmt: skip
-    return VelocityIk(scene, spec.method, spec.dt, velocity, spec.d_min, task)
+    return VelocityIk(scene, spec.method, spec.dt, velocity, spec.d_min, task, rate=rate)
 
 
 def rate_limits(spec: PlannerSpec, robot: RobotModel) -> RateLimits | None:
     """The joint speed limits of `robot` (its URDF's, times velocity_scale; a joint without
-    one has none) and the acceleration limit a PlannerSpec asks for.
+    one has none) and, with limits = "velocity+acceleration", its acceleration limits
+    (max_acceleration for every joint when given), relative to the last period's motion.
 
     Args:
         spec: the validated [planner] table.
         robot: the robot whose URDF velocity limits are scaled.
 
     Returns:
-        The per-period limits, or None when spec.limits is "none".
+        The per-period limits, or None when spec.limits is "none" (the baselines then keep
+        the speed limits alone).
     """
     if spec.limits == "none":
         return None
     speeds = np.where(robot.velocity_limit > 0, robot.velocity_limit, np.inf)
-    return RateLimits(spec.velocity_scale * speeds, spec.dt, spec.max_acceleration)
+    acceleration = None
+    if spec.limits == "velocity+acceleration":
+        acceleration = (
+            robot.acceleration_limit if spec.max_acceleration is None else spec.max_acceleration
+        )
+    return RateLimits(spec.velocity_scale * speeds, spec.dt, acceleration)
 
 
 # "QpIkParams.safety" -> "planner.safety": the library's names of the [planner] keys.

@@ -33,6 +33,12 @@ class Planner(Protocol):
         """Inner iterations (BAORNN) or solver calls (baselines) done so far."""
         ...
 
+    @property
+    def infeasible(self) -> int:
+        """Periods whose step could not keep every constraint (it braked, or ended closer
+        than d_min or self_d_min) or whose limits could not all hold."""
+        ...
+
     def step(self, q: np.ndarray, target: Target, t: float) -> np.ndarray:
         """The configuration [rad] for time t [s].
 
@@ -48,4 +54,22 @@ class Planner(Protocol):
 
     def reset(self) -> None:
         """Forget the previous periods (their motion, their reference): a new start at rest."""
+        ...
+
+    def follow(self, motion: np.ndarray) -> None:
+        """Take the arm's measured joint motion over the period that ended as its motion.
+
+        Args:
+            motion: the measured joint displacement over that period, shape (nq,) [rad].
+        """
+        ...
+
+    def warm_up(self, q: np.ndarray, target: Target) -> None:
+        """Compile (or load from numba's cache) every kernel a step runs, leaving no trace: the
+        same counts, random state and memory as before.
+
+        Args:
+            q: a configuration to step from, shape (nq,) [rad].
+            target: a target to step toward.
+        """
         ...

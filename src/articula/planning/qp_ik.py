@@ -4,8 +4,8 @@ every period."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
-from functools import cached_property
 
 import daqp
 import numpy as np
@@ -13,10 +13,14 @@ from pydantic import model_validator
 
 from articula.numba_cache import jit
 from articula.planning.clearance import RowSource
+from articula.planning.rate_limits import RateLimits
 from articula.planning.reference_velocity import RateParams, task_rows
+from articula.planning.resolved_rate import ResolvedRate
 from articula.planning.task import Target, Task, as_target
 from articula.scene.scene import Scene
 from articula.validation import NonNegative, field_error
+
+UNLIMITED = 1e3  # [rad/s] the solver's bound on a joint speed no limit bounds
 
 
 class QpIkParams(RateParams):
@@ -44,7 +48,7 @@ class QpIkParams(RateParams):
     slack_weight: NonNegative = 1e4
     damper_gain: NonNegative = 1.0
     safety: NonNegative = 0.03
-    self_safety: NonNegative = 0.005
+    self_safety: NonNegative = 0.01
     limit_influence: NonNegative = 0.05
     limit_safety: NonNegative = 0.005
 
@@ -61,8 +65,13 @@ class QpIkParams(RateParams):
 
 
 @dataclass
-class QpIk:
+class QpIk(ResolvedRate):
     """The NEO-style controller on the same Scene distances and Jacobians, solved by daqp.
+
+    Its joint velocities stay in the box the rate limits allow this period (speeds, and
+    accelerations relative to the last motion); a damper that box cannot honour is relaxed to
+    the nearest it can (the period counts as infeasible), and a period whose QP has no solution
+    brakes as hard as the limits allow.
 
     Attributes:
         scene: the robot, its obstacles and its checked link pairs.
@@ -71,8 +80,11 @@ class QpIk:
         d_min: hard minimum clearance the start must respect (Eq. 1.12) [m].
         task: what the end effector tracks.
         use_compiled: take distances and kinematics from CompiledClearance where possible.
+        rate: joint speed and acceleration limits; None: the URDF's speeds times
+            params.speed_scale.
         iterations: QP solves so far.
-        infeasible: periods whose QP had no solution (the arm stopped).
+        infeasible: periods whose QP had no solution (the arm braked), or where a damper or a
+            limit could not hold.
     """
 
     scene: Scene
@@ -81,6 +93,7 @@ class QpIk:
     d_min: float = 0.0
     task: Task = field(default_factory=Task)
     use_compiled: bool = True
+    rate: RateLimits | None = None
     iterations: int = field(default=0, init=False)
     infeasible: int = field(default=0, init=False)
     _previous: Target | None = field(default=None, init=False)
@@ -88,13 +101,11 @@ class QpIk:
 
     def __post_init__(self) -> None:
         self._rows = RowSource(self.scene, self.use_compiled)
-
-    def reset(self) -> None:
-        """Forget the previous target: the next period has no feed-forward."""
-        self._previous = None
+        self._set_limits(self.params.speed_scale)
 
     def step(self, q: np.ndarray, target: Target | np.ndarray, t: float) -> np.ndarray:
-        """One period: solve for q̇ (stop if the QP has no solution) and integrate for dt.
+        """One period: solve for q̇ within this period's box (brake if the QP has no
+        solution) and integrate for dt.
 
         Args:
             q: joint angles at the start of the period, shape (nq,) [rad].
@@ -102,43 +113,48 @@ class QpIk:
             t: time of the period, placing moving obstacles [s].
 
         Returns:
-            The joint angles after dt, clipped to the joint limits, shape (nq,) [rad].
+            The joint angles after dt, within the joint limits, shape (nq,) [rad].
         """
-        qdot = self._solve(q, as_target(target), t)
-        self.iterations += 1
-        if qdot is None:
-            self.infeasible += 1
-            return q.copy()
-        return self.scene.robot.clip(q + self.dt * qdot)
-
-    def _solve(self, q: np.ndarray, target: Target, t: float) -> np.ndarray | None:
         robot, p, n = self.scene.robot, self.params, self.scene.robot.nq
+        target = as_target(target)
+        box = self._box(q)
         ee, rows = self._rows(q, t, p.influence)
         J, v = task_rows(ee.x, ee.R, ee.J, self.task, target, self._previous, self.dt, p.gain)
         self._previous = target
+        # A joint without a speed limit still gets a finite bound for the solver [rad/s].
+        qdot_low, qdot_high = (np.clip((b - q) / self.dt, -UNLIMITED, UNLIMITED) for b in box)
         model = robot.model
-        H, A, upper, lower, sense = _qp_arrays(
-            q, model.lowerPositionLimit, model.upperPositionLimit, self._speed_bound, J, v,
-            rows.distance, rows.gradient, rows.self_pair, p.safety, p.self_safety, p.influence,
+        change = self._limits.change
+        H, A, upper, lower, sense, relaxed = _qp_arrays(
+            q, model.lowerPositionLimit, model.upperPositionLimit, qdot_low, qdot_high,
+            np.full(n, np.inf) if change is None else change, self.dt,
+            J, v, rows.distance, rows.gradient, rows.self_pair,
+            max(p.safety, self.d_min), max(p.self_safety, self.scene.self_d_min), p.influence,
             p.damper_gain, p.limit_influence, p.limit_safety, p.joint_weight, p.slack_weight,
         )  # fmt: skip
         solution, _, status, _ = daqp.solve(H, np.zeros(H.shape[0]), A, upper, lower, sense)
-        return solution[:n] if status > 0 else None
-
-    @cached_property
-    def _speed_bound(self) -> np.ndarray:
-        """The joint speed bound [rad/s]: a URDF limit of 0 means none was given."""
-        limit = self.scene.robot.velocity_limit
-        return self.params.speed_scale * np.where(limit > 0, limit, 1e3)
+        self.iterations += 1
+        if status <= 0:
+            return self._finish(q, q, box, rows, t, strained=True)  # brake: nearest to rest
+        return self._finish(q, q + self.dt * solution[:n], box, rows, t, strained=relaxed)
 
 
 @jit()
 def _qp_arrays(
-    q, q_lower, q_upper, speed_bound, J, v, distance, gradient, self_pair, safety, self_safety,
-    influence, damper_gain, limit_influence, limit_safety, joint_weight, slack_weight,
+    q, q_lower, q_upper, qdot_low, qdot_high, change, dt, J, v, distance, gradient, self_pair,
+    safety, self_safety, influence, damper_gain, limit_influence, limit_safety, joint_weight,
+    slack_weight,
 ):  # fmt: skip
-    """daqp's (H, A, upper, lower, sense) of one period: box bounds on (q̇, δ), then the
-    inequality rows G x ≤ h, then the task rows J q̇ + δ = v (sense 5, equality)."""
+    """daqp's (H, A, upper, lower, sense) of one period, and whether a damper was relaxed: box
+    bounds on (q̇, δ) (q̇ within [qdot_low, qdot_high]), then the inequality rows G x ≤ h, then
+    the task rows J q̇ + δ = v (sense 5, equality).
+
+    With acceleration limits (`change`, each joint's largest change of motion per period
+    [rad]; inf: none) a distance row also approaches no faster than it can still stop before
+    d_s: a row's approach per period can shrink by C = Σ|∇d_j| c_j a period, so it keeps
+    s + s²/(2C) ≤ d − d_s, as each joint does before its position limit. A damper row that no
+    q̇ of the box meets is relaxed to the least any does (braking that cannot honour it is the
+    most the arm can do)."""
     n, m, c = q.size, J.shape[0], distance.size
     near_up = np.flatnonzero(q_upper - q < limit_influence)
     near_down = np.flatnonzero(q - q_lower < limit_influence)
@@ -146,13 +162,22 @@ def _qp_arrays(
     A = np.zeros((k + m, n + m))
     upper = np.empty(n + m + k + m)
     lower = np.full(upper.size, -1e30)
-    upper[:n] = speed_bound
+    upper[:n] = qdot_high
+    lower[:n] = qdot_low
     upper[n : n + m] = 1e3
+    lower[n : n + m] = -1e3
     # Velocity dampers: −∇d·q̇ ≤ ξ (d − d_s)/(d_i − d_s), approach no faster than that.
     for r in range(c):
         d_s = self_safety if self_pair[r] else safety
         A[r, :n] = -gradient[r]
         upper[n + m + r] = damper_gain * (distance[r] - d_s) / (influence - d_s)
+        brake = 0.0  # C of the row [m]
+        for j in range(n):
+            brake += abs(gradient[r, j]) * change[j]
+        if 0.0 < brake < np.inf:
+            room = max(distance[r] - d_s, 0.0)
+            reach = brake * (math.sqrt(1.0 + 2.0 * room / brake) - 1.0)  # [m] per period
+            upper[n + m + r] = min(upper[n + m + r], reach / dt)
     # Joint-limit dampers: the same law on the room left to each limit [rad].
     span = limit_influence - limit_safety
     for i, j in enumerate(near_up):
@@ -163,14 +188,21 @@ def _qp_arrays(
         upper[n + m + c + near_up.size + i] = (
             damper_gain * (q[j] - q_lower[j] - limit_safety) / span
         )
+    relaxed = False
+    for r in range(k):
+        least = 0.0  # the smallest A[r] q̇ over the box
+        for j in range(n):
+            least += min(A[r, j] * qdot_low[j], A[r, j] * qdot_high[j])
+        if upper[n + m + r] < least:
+            upper[n + m + r] = least + 1e-12 * (1.0 + abs(least))
+            relaxed = True
     A[k:, :n] = J
     for i in range(m):
         A[k + i, n + i] = 1.0
     upper[n + m + k :] = v
-    lower[: n + m] = -upper[: n + m]
     sense = np.zeros(upper.size, dtype=np.intc)
     sense[n + m + k :] = 5
     H = np.zeros((n + m, n + m))
     for i in range(n + m):
         H[i, i] = joint_weight if i < n else slack_weight
-    return H, A, upper, lower, sense
+    return H, A, upper, lower, sense, relaxed

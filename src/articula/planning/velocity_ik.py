@@ -9,7 +9,9 @@ from typing import Literal
 import numpy as np
 
 from articula.planning.clearance import ClearanceRows, RowSource
+from articula.planning.rate_limits import ROUND_OFF, RateLimits
 from articula.planning.reference_velocity import RateParams, task_rows
+from articula.planning.resolved_rate import ResolvedRate
 from articula.planning.task import Target, Task, as_target
 from articula.scene.scene import Scene
 from articula.validation import NonNegative
@@ -34,18 +36,26 @@ class VelocityIkParams(RateParams):
 
 
 @dataclass
-class VelocityIk:
+class VelocityIk(ResolvedRate):
     """Resolved-rate control of the end effector's task (position, pose or axis).
+
+    The period's joint motion is scaled into the box the rate limits allow (its change from
+    the last motion keeps its direction), and a motion that would bring links closer than
+    d_min to an obstacle or self_d_min to each other is halved toward braking.
 
     Attributes:
         scene: the robot, its obstacles and its checked link pairs.
         method: "pinv" (Jacobian pseudo-inverse) or "dls" (damped least squares).
         dt: control period [s].
         params: gains of the control law.
-        d_min: hard minimum clearance the start must respect (Eq. 1.12) [m].
+        d_min: hard minimum clearance (Eq. 1.12) the start and every step keep [m].
         task: what the end effector tracks.
         use_compiled: take distances and kinematics from CompiledClearance where possible.
+        rate: joint speed and acceleration limits; None: the URDF's speeds times
+            params.speed_scale.
         iterations: control periods computed so far.
+        infeasible: periods that braked because no motion kept the clearances, or whose
+            limits could not all hold.
     """
 
     scene: Scene
@@ -55,19 +65,18 @@ class VelocityIk:
     d_min: float = 0.0
     task: Task = field(default_factory=Task)
     use_compiled: bool = True
+    rate: RateLimits | None = None
     iterations: int = field(default=0, init=False)
+    infeasible: int = field(default=0, init=False)
     _previous: Target | None = field(default=None, init=False)
     _rows: RowSource = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         self._rows = RowSource(self.scene, self.use_compiled)
-
-    def reset(self) -> None:
-        """Forget the previous target: the next period has no feed-forward."""
-        self._previous = None
+        self._set_limits(self.params.speed_scale)
 
     def step(self, q: np.ndarray, target: Target | np.ndarray, t: float) -> np.ndarray:
-        """One period: integrate q̇ for dt and clip to the joint limits.
+        """One period: integrate q̇ for dt within the period's box.
 
         Args:
             q: joint angles at the start of the period, shape (nq,) [rad].
@@ -75,10 +84,11 @@ class VelocityIk:
             t: time of the period, placing moving obstacles [s].
 
         Returns:
-            The joint angles after dt, shape (nq,) [rad].
+            The joint angles after dt, within the joint limits, shape (nq,) [rad].
         """
         robot, p = self.scene.robot, self.params
         target = as_target(target)
+        box = self._box(q)
         ee, rows = self._rows(q, t, p.influence)
         J, v = task_rows(ee.x, ee.R, ee.J, self.task, target, self._previous, self.dt, p.gain)
         self._previous = target
@@ -96,7 +106,9 @@ class VelocityIk:
         repulsion = _limit_speed(self._repulsion(rows), 0.5 * limit)
         qdot = J_task @ v + (np.eye(robot.nq) - J_pinv @ J) @ repulsion
         self.iterations += 1
-        return robot.clip(q + self.dt * _limit_speed(qdot, limit))
+        motion = _scale_into(self.dt * _limit_speed(qdot, limit), box[0] - q, box[1] - q,
+                             self._limits.last_motion)  # fmt: skip
+        return self._finish(q, q + motion, box, rows, t)
 
     def _repulsion(self, rows: ClearanceRows) -> np.ndarray:
         """The null-space term q̇_0 [rad/s] of the rows within the influence distance."""
@@ -106,6 +118,22 @@ class VelocityIk:
         d = np.maximum(rows.distance, 1e-3)  # inside an obstacle: push as hard as at 1 mm
         weights = p.repulsion * (1.0 / d - 1.0 / p.influence) / d**2
         return weights @ rows.gradient
+
+
+def _scale_into(
+    motion: np.ndarray, low: np.ndarray, high: np.ndarray, last: np.ndarray | None
+) -> np.ndarray:
+    """The motion [rad] within [low, high]: its change from the last motion (clipped into the
+    box; rest when there is none) scaled down uniformly until it fits; a joint over by no more
+    than round-off is clipped instead (it would otherwise pin the scale at 0)."""
+    base = np.clip(np.zeros_like(motion) if last is None else last, low, high)
+    change = motion - base
+    excess = np.maximum(motion - high, low - motion)
+    over = excess > ROUND_OFF * np.maximum(high - low, 1e-12)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        room = np.where(change > 0, (high - base) / change, (low - base) / change)
+    scale = float(np.min(room[over], initial=1.0))
+    return np.clip(base + min(1.0, max(scale, 0.0)) * change, low, high)
 
 
 def _limit_speed(qdot: np.ndarray, limit: np.ndarray) -> np.ndarray:

@@ -14,9 +14,8 @@ from articula.errors import ConfigError, ModelError
 from articula.limits import MAX_ANGLE, MAX_LENGTH
 
 # Limits [rad] given to a continuous joint, read as a revolute one so that it keeps one
-# configuration entry (Pinocchio's unbounded joints use two, cos and sin). ±2π lets the joint
-# reach every orientation from either side and turn a full circle each way from 0, while BAORNN's
-# samples within the limits stay meaningful (±MAX_ANGLE would spread them over 300 turns).
+# configuration entry (Pinocchio's unbounded joints use two, cos and sin). RobotModel wraps the
+# joint's values to (−π, π], so these never bind: the joint has no position limit.
 CONTINUOUS_LIMIT = 2 * np.pi
 
 
@@ -57,21 +56,26 @@ def _check_serial(model: pin.Model, urdf: Path) -> None:
             )
 
 
-def _prepare_urdf(urdf: Path) -> tuple[str, list[tuple[str, str]], dict[str, str]]:
+def _prepare_urdf(
+    urdf: Path,
+) -> tuple[str, list[tuple[str, str]], dict[str, str], list[str]]:
     """(URDF text with every continuous joint made revolute within ±CONTINUOUS_LIMIT, the
-    (joint, "velocity" | "effort") limits it lacked, mimic joint -> the joint it follows)."""
+    (joint, "velocity" | "effort") limits it lacked, mimic joint -> the joint it follows, the
+    continuous joints' names)."""
     try:
         root = ET.parse(urdf).getroot()
     except (ET.ParseError, OSError) as exc:
         raise ModelError(f"{urdf}: cannot read URDF ({exc})") from None
     unlimited = []
     mimics = {}
+    continuous = []
     for joint in root.iter("joint"):
         mimic = joint.find("mimic")
         if mimic is not None:
             mimics[joint.get("name", "")] = mimic.get("joint", "")
         if joint.get("type") != "continuous":
             continue
+        continuous.append(joint.get("name", ""))
         joint.set("type", "revolute")
         limit = joint.find("limit")
         if limit is None:
@@ -84,7 +88,7 @@ def _prepare_urdf(urdf: Path) -> tuple[str, list[tuple[str, str]], dict[str, str
                 # as ∞, what Pinocchio gives a continuous joint without it.
                 unlimited.append((joint.get("name", ""), key))
                 limit.set(key, "0")
-    return ET.tostring(root, encoding="unicode"), unlimited, mimics
+    return ET.tostring(root, encoding="unicode"), unlimited, mimics, continuous
 
 
 def _unbounded(model: pin.Model, missing: Sequence[tuple[str, str]]) -> None:

@@ -26,6 +26,26 @@ from articula.robots._urdf_kinematics import (
 from articula.robots.urdf_geometry import collision_shapes
 
 BUILTIN = {"iiwa14": ("iiwa14/iiwa14.urdf", "iiwa_link_ee")}
+# [s] Without stated acceleration limits, a joint may reach its URDF speed limit from rest in
+# no less than this: limit / ACCEL_TIME [rad/s²] (a Franka's 7.5-20 rad/s² is 0.1-0.3 s).
+ACCEL_TIME = 0.25
+
+
+def acceleration_from_speed(speeds: np.ndarray, accel_time: float) -> np.ndarray:
+    """The acceleration [rad/s² or m/s²] that reaches each speed limit from rest in
+    `accel_time` [s]: speed / accel_time; inf where a joint has no speed limit (0 or inf).
+
+    Args:
+        speeds: joint speed limits, shape (nq,) [rad/s or m/s].
+        accel_time: time from rest to the speed limit [s], > 0.
+
+    Returns:
+        The acceleration limits, shape (nq,).
+    """
+    if not (np.isfinite(accel_time) and accel_time > 0):
+        raise ConfigError("accel_time", f"must be finite and > 0 s (got {accel_time})")
+    with np.errstate(over="ignore"):  # a speed near the float range has no useful limit
+        return np.where(np.asarray(speeds) > 0, np.asarray(speeds) / accel_time, np.inf)
 
 
 @dataclass(frozen=True, eq=False)
@@ -51,13 +71,30 @@ class RobotModel:
     Mimic joints (URDF <mimic>) have no configuration entry of their own: they follow the
     joint they mimic, q_mimic = multiplier · q_joint + offset, in every kinematic quantity.
 
+    Continuous joints have no position limit: their values wrap to (−π, π] (`wrap`) and their
+    motion is taken the shortest way round (`difference`).
+
     Args:
         model: the Pinocchio kinematic model.
         links: the collision shapes of the links, in frame order.
         ee_frame: name of the end-effector frame.
+        continuous: names of the continuous joints (unknown names, such as locked joints, are
+            ignored).
+
+    Attributes:
+        continuous: True for each continuous joint, shape (nq,).
+        acceleration_limit: joint acceleration limits [rad/s² or m/s²], inf for none; by
+            default each URDF speed limit reached from rest in ACCEL_TIME (scene files set it
+            from [robot] acceleration_limits or accel_time).
     """
 
-    def __init__(self, model: pin.Model, links: Sequence[LinkGeometry], ee_frame: str) -> None:
+    def __init__(
+        self,
+        model: pin.Model,
+        links: Sequence[LinkGeometry],
+        ee_frame: str,
+        continuous: Collection[str] = (),
+    ) -> None:
         if not model.existFrame(ee_frame):
             names = [f.name for f in model.frames if f.type == pin.FrameType.BODY]
             raise ConfigError("ee_frame", f"no frame {ee_frame!r}; the links are {names}")
@@ -66,6 +103,8 @@ class RobotModel:
         self.links = tuple(links)
         self.ee_frame = ee_frame
         self.ee_frame_id = model.getFrameId(ee_frame)
+        self.continuous = np.array([name in continuous for name in self.joint_names], dtype=bool)
+        self.acceleration_limit = acceleration_from_speed(model.velocityLimit, ACCEL_TIME)
 
     @classmethod
     def from_urdf(
@@ -80,8 +119,8 @@ class RobotModel:
     ) -> RobotModel:
         """Load kinematics and collision shapes.
 
-        Continuous joints become revolute joints within ±CONTINUOUS_LIMIT [rad]; mimic joints
-        follow the joint they mimic.
+        Continuous joints keep one configuration entry each, with no position limit (their
+        values wrap to (−π, π]); mimic joints follow the joint they mimic.
 
         Args:
             path: the URDF file.
@@ -94,7 +133,7 @@ class RobotModel:
             ee_offset: pose (4×4) of the tool point in the `ee_frame` frame [m]; the tool
                 point becomes a new frame, named `<ee_frame>_offset`, and the end effector.
             decompose: link meshes to split into convex parts with CoACD (cached on disk, see
-                geometry.meshes.cache_folder) instead of one hull per separate part: True for
+                disk_cache.cache_folder) instead of one hull per separate part: True for
                 every link, or link names; a non-convex link then keeps its concavities
                 (tighter clearance) at the cost of a decomposition on first load.
 
@@ -105,7 +144,7 @@ class RobotModel:
         if not urdf.is_file():
             raise ConfigError("urdf", f"{urdf}: file not found")
         _check_size(urdf, max_links)
-        xml, continuous, mimics = _prepare_urdf(urdf)
+        xml, unlimited, mimics, continuous = _prepare_urdf(urdf)
         failure: Exception | None = None
         with captured_output() as printed:  # the parser prints its errors past sys.stdout
             try:
@@ -115,7 +154,7 @@ class RobotModel:
         if failure is not None:
             said = f"; the parser said: {' '.join(printed[:2])}" if printed else ""
             raise ModelError(f"{urdf}: Pinocchio cannot build the model ({failure}){said}")
-        _unbounded(model, continuous)
+        _unbounded(model, unlimited)
         _check_serial(model, urdf)
         _check_magnitudes(model, urdf)
         if locked_joints:
@@ -134,7 +173,7 @@ class RobotModel:
             ee_frame = [f.name for f in model.frames if f.type == pin.FrameType.BODY][-1]
         if ee_offset is not None:
             ee_frame = _add_tool_frame(model, ee_frame, ee_offset)
-        return cls(model, links, ee_frame)
+        return cls(model, links, ee_frame, continuous)
 
     @classmethod
     def builtin(
@@ -185,13 +224,20 @@ class RobotModel:
 
     @property
     def lower(self) -> np.ndarray:
-        """Lower joint limits [rad or m]."""
-        return self.model.lowerPositionLimit.copy()
+        """Lower joint limits [rad or m]; −inf for a continuous joint."""
+        return np.where(self.continuous, -np.inf, self.model.lowerPositionLimit)
 
     @property
     def upper(self) -> np.ndarray:
-        """Upper joint limits [rad or m]."""
-        return self.model.upperPositionLimit.copy()
+        """Upper joint limits [rad or m]; +inf for a continuous joint."""
+        return np.where(self.continuous, np.inf, self.model.upperPositionLimit)
+
+    @property
+    def sample_range(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lower, upper) ends of the range joint values are drawn from [rad or m]: the limits,
+        or ±π for a continuous joint."""
+        return (np.where(self.continuous, -np.pi, self.model.lowerPositionLimit),
+                np.where(self.continuous, np.pi, self.model.upperPositionLimit))  # fmt: skip
 
     @property
     def velocity_limit(self) -> np.ndarray:
@@ -199,7 +245,8 @@ class RobotModel:
         return self.model.velocityLimit.copy()
 
     def clip(self, q: np.ndarray) -> np.ndarray:
-        """q clipped into the joint limits (the projection of Eq. 1.17).
+        """q clipped into the joint limits (the projection of Eq. 1.17); a continuous joint
+        within ±2π, more than a period's motion from any q that `wrap` returns.
 
         Args:
             q: joint positions, shape (nq,) [rad or m].
@@ -209,6 +256,29 @@ class RobotModel:
         """
         return np.minimum(np.maximum(q, self.model.lowerPositionLimit),
                           self.model.upperPositionLimit)  # fmt: skip
+
+    def wrap(self, q: np.ndarray) -> np.ndarray:
+        """q with each continuous joint's value wrapped to (−π, π] (the others as they are).
+
+        Args:
+            q: joint positions, shape (..., nq) [rad or m].
+
+        Returns:
+            The wrapped joint positions, same shape [rad or m].
+        """
+        return np.where(self.continuous, np.pi - np.mod(np.pi - q, 2 * np.pi), q)
+
+    def difference(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """a − b, the shortest way round for a continuous joint (in (−π, π]).
+
+        Args:
+            a: joint positions, shape (..., nq) [rad or m].
+            b: joint positions, broadcastable to a [rad or m].
+
+        Returns:
+            The joint motion from b to a, same shape as a [rad or m].
+        """
+        return self.wrap(np.asarray(a) - np.asarray(b)) if self.continuous.any() else a - b
 
     def check_q(self, q: Sequence[float] | np.ndarray, field: str = "q") -> np.ndarray:
         """q as a float array of length nq, or ConfigError naming the problem.

@@ -222,7 +222,10 @@ def atomic_write(path: Path, data: bytes) -> None:
         os.close(dir_fd)
 
 
-def _json_number(value: float) -> float | None:
-    """A metric as JSON allows it: non-finite values become null."""
+def _json_number(value: float | None) -> float | None:
+    """A metric as JSON allows it: non-finite values become null, as does None (a metric
+    that does not apply, such as the self clearance of an arm without checked pairs)."""
+    if value is None:
+        return None
     value = float(value)
     return value if math.isfinite(value) else None

@@ -6,6 +6,8 @@ A base of Scene, which sets up the geometry models, placements and pair lists th
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 import pinocchio as pin
 
@@ -28,6 +30,25 @@ class _PairDistances:
         request.cached_gjk_guess = _NO_GJK_GUESS
         pin.computeDistance(self._geo.exact, self._exact_data, p)
         return self._results[p].min_distance
+
+    def self_distances_of(self, q: np.ndarray, pairs: Sequence[int]) -> np.ndarray:
+        """Signed distance [m] of some of the checked link pairs alone (exact, GJK metric).
+
+        Args:
+            q: joint positions, shape (nq,) [rad or m] (unchecked).
+            pairs: indices into `self_pairs`.
+
+        Returns:
+            Their distances, in the order of `pairs`, shape (len(pairs),) [m].
+        """
+        if not hasattr(self, "_geometry_of_self_pair"):
+            self._geometry_of_self_pair: dict[int, list[int]] = {}
+            for p in range(self._n_obstacle_pairs, len(self._cell_of_pair)):
+                self._geometry_of_self_pair.setdefault(self._cell_of_pair[p][1], []).append(p)
+        self._place(q, 0.0)
+        return np.array(
+            [min(self._exact(p) for p in self._geometry_of_self_pair[k]) for k in pairs]
+        )
 
     def _pair_distances(
         self, q: np.ndarray, t: float, every_pair: bool = False, within: float = np.inf

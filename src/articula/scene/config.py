@@ -14,10 +14,10 @@ from articula.geometry.meshes import convex_parts, load_mesh
 from articula.geometry.poses import pose
 from articula.geometry.shapes import ConvexShape, box, capsule, cylinder, sphere
 from articula.limits import MAX_DECOMPOSE_VERTICES, MAX_LENGTH, MAX_LINKS, MAX_SCALE, MIN_SCALE
-from articula.robots.model import RobotModel
+from articula.robots.model import ACCEL_TIME, RobotModel, acceleration_from_speed
 from articula.scene.obstacles import Obstacle
 from articula.scene.pairs import link_pairs
-from articula.scene.scene import Metric, Scene
+from articula.scene.scene import SELF_D_MIN, Metric, Scene
 from articula.scene.self_collision import (
     MARGIN,
     SAMPLES,
@@ -26,6 +26,7 @@ from articula.scene.self_collision import (
 )
 from articula.validation import (
     Point,
+    Positive,
     PositiveLength,
     Radians,
     StrictModel,
@@ -67,7 +68,13 @@ class RobotSpec(StrictModel):
         q0: initial joint positions, one per joint [rad]; default all zero.
         max_links: largest URDF accepted, in links.
         decompose: link meshes CoACD decomposes into convex parts: true for all, or link names.
-        self_collision: whether link-link distances count as clearance too.
+        self_collision: whether link-link distances are checked: every planner keeps the
+            links of a checked pair self_d_min apart, and a step closer than 0 is a collision.
+        self_d_min: clearance every planner keeps between the links of a checked pair [m].
+        acceleration_limits: joint acceleration limits, one for every joint or one per joint
+            [rad/s² or m/s²]; None: each joint's URDF speed limit over accel_time.
+        accel_time: time from rest to a joint's URDF speed limit when acceleration_limits
+            is not given [s].
         allow_pairs: [a, b] link name pairs never checked for self-collision.
         self_collision_samples: random configurations the allowed-collision matrix is built on.
         self_collision_margin: a link pair never closer than this over the samples is not
@@ -85,9 +92,12 @@ class RobotSpec(StrictModel):
     # Link meshes CoACD decomposes (true: all; or link names) instead of one hull per part:
     # a non-convex link keeps its concavities, so clearance is not under-stated there.
     decompose: bool | list[str] = False
-    # Link-link distances count as clearance, for the pairs of scene/self_collision.py's
+    # Link-link distances are kept above self_d_min, for the pairs of scene/self_collision.py's
     # allowed-collision matrix; allow_pairs are never checked.
-    self_collision: bool = False
+    self_collision: bool = True
+    self_d_min: Annotated[float, Field(ge=0, le=MAX_LENGTH, allow_inf_nan=False)] = SELF_D_MIN
+    acceleration_limits: Positive | list[Positive] | None = None
+    accel_time: Positive = ACCEL_TIME
     allow_pairs: list[Annotated[list[str], Field(min_length=2, max_length=2)]] = Field(
         default_factory=list
     )
@@ -206,6 +216,7 @@ def build_scene(
                 offset,
                 decompose=r.decompose,
             )
+        robot.acceleration_limit = _acceleration_limits(r, robot)
     q0 = robot.check_q(r.q0 if r.q0 is not None else np.zeros(robot.nq), "robot.q0")
     obstacles = []
     for i, o in enumerate(spec.obstacles):
@@ -216,7 +227,7 @@ def build_scene(
     names = [link.name for link in robot.links]
     link_pairs(r.allow_pairs, names, "robot.allow_pairs")  # a typo is an error even when off
     self_pairs = robot_self_collision(spec, robot).checked if r.self_collision else ()
-    return Scene(robot, obstacles, broadphase, metric, self_pairs), q0
+    return Scene(robot, obstacles, broadphase, metric, self_pairs, r.self_d_min), q0
 
 
 def robot_self_collision(spec: SceneSpec, robot: RobotModel) -> SelfCollisionMatrix:
@@ -235,6 +246,22 @@ def robot_self_collision(spec: SceneSpec, robot: RobotModel) -> SelfCollisionMat
         return self_collision_matrix(
             robot, r.allow_pairs, r.self_collision_samples, r.self_collision_margin
         )
+
+
+def _acceleration_limits(spec: RobotSpec, robot: RobotModel) -> np.ndarray:
+    """The joint acceleration limits [rad/s²] of [robot]: acceleration_limits (one number or
+    one per joint), else each URDF speed limit over accel_time."""
+    if spec.acceleration_limits is None:
+        return acceleration_from_speed(robot.velocity_limit, spec.accel_time)
+    limits = np.asarray(spec.acceleration_limits, dtype=float)
+    if limits.ndim == 0:
+        return np.full(robot.nq, float(limits))
+    if limits.shape != (robot.nq,):
+        raise ConfigError(
+            "acceleration_limits",
+            f"needs one number or {robot.nq}, one per joint [rad/s²] (got {limits.size})",
+        )
+    return limits
 
 
 def _obstacle(spec: ObstacleSpec, index: int, base_dir: Path) -> Obstacle:

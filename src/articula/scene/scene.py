@@ -27,6 +27,7 @@ from articula.scene.obstacles import Obstacle
 from articula.scene.pairs import SelfWitnesses, Witnesses, link_pairs
 
 Metric = Literal["gjk", "vertex"]
+SELF_D_MIN = 0.005  # [m] default clearance kept between the links of a checked pair
 
 
 class _Geometry:
@@ -67,6 +68,8 @@ class Scene(_PairDistances):
             closest pair of vertices, which over-states clearance (docs/deviations.md).
         self_pairs: the link pairs (by name) whose distance counts as clearance too, usually
             self_collision_matrix(robot).checked (the pairs not adjacent that can come close).
+        self_d_min: the clearance [m] every planner keeps between the links of a checked pair,
+            as d_min (Eq. 1.12) between links and obstacles.
     """
 
     def __init__(
@@ -76,6 +79,7 @@ class Scene(_PairDistances):
         broadphase: bool = True,
         metric: Metric = "gjk",
         self_pairs: Sequence[tuple[str, str]] = (),
+        self_d_min: float = SELF_D_MIN,
     ) -> None:
         if metric not in ("gjk", "vertex"):
             raise ConfigError("metric", f"unknown metric {metric!r}; choose 'gjk' or 'vertex'")
@@ -88,6 +92,9 @@ class Scene(_PairDistances):
         self.metric: Metric = metric
         self.link_names = [link.name for link in robot.links]
         self.self_pairs = link_pairs(self_pairs, self.link_names, "self_pairs")
+        if not (np.isfinite(self_d_min) and self_d_min >= 0):
+            raise ConfigError("self_d_min", f"must be finite and >= 0 m (got {self_d_min})")
+        self.self_d_min = float(self_d_min)
         geo = _Geometry()
         link_geoms = []
         for li, link in enumerate(robot.links):
@@ -117,15 +124,17 @@ class Scene(_PairDistances):
         self._n_obstacle_pairs = len(cells)
         # Self pairs follow, one per (shape of a, shape of b); their cell is (-1, pair index).
         self_cells = []
+        shapes_of: dict[int, list[int]] = {}
+        for g, li in link_geoms:
+            shapes_of.setdefault(li, []).append(g)
         for k, (a, b) in enumerate(self.self_pairs):
-            for g_a, la in link_geoms:
-                for g_b, lb in link_geoms:
-                    if (la, lb) == (a, b):
-                        geo.pair(g_a, g_b)
-                        cells.append((-1, k))
-                        self_cells.append(k)
-                        joints = {geo.exact.geometryObjects[g].parentJoint for g in (g_a, g_b)}
-                        static.append(joints == {0})
+            for g_a in shapes_of.get(a, []):
+                for g_b in shapes_of.get(b, []):
+                    geo.pair(g_a, g_b)
+                    cells.append((-1, k))
+                    self_cells.append(k)
+                    joints = {geo.exact.geometryObjects[g].parentJoint for g in (g_a, g_b)}
+                    static.append(joints == {0})
         self._geo = geo
         self._cells = np.array(cells[: self._n_obstacle_pairs], dtype=np.int64).reshape(-1, 2)
         self._self_cells = np.array(self_cells, dtype=np.int64)

@@ -22,7 +22,6 @@ from articula.errors import ArticulaError
 from articula.loops.online import OnlineController
 from articula.loops.tracking import PlanResult, trace_columns, tracking_metrics
 from articula.planning.config import (
-    ACCELERATION_METHODS,
     PlannerSpec,
     TrajectorySpec,
     absolute_paths,
@@ -171,10 +170,7 @@ class Live:
         """
         panel = {"method": self.method.value, "lambda_weight": float(self.lam.value),
                  "d_min": float(self.d_min.value)}  # fmt: skip
-        planner = self.config["planner"] | panel
-        if panel["method"] not in ACCELERATION_METHODS:
-            planner.pop("max_acceleration", None)  # BAORNN's alone; the others refuse it
-        return PlannerSpec(**planner)
+        return PlannerSpec(**(self.config["planner"] | panel))
 
     def rebuild(self) -> None:
         """A new controller from the panel's settings, started from the arm where it is; on
@@ -231,7 +227,7 @@ class Live:
             clearance = float(d.min())
             self._draw(d, x, target, clearance, elapsed)
         else:
-            clearance = scene.min_distance(self.q, t) if scene.obstacles else np.inf
+            clearance = scene.clearances(self.q, t)[0] if scene.obstacles else np.inf
         r = self.recording
         r.t.append(t)
         r.q.append(self.q.copy())

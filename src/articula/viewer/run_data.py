@@ -58,8 +58,7 @@ class RunData:
         x: achieved end-effector positions, shape (N, 3) [m].
         x_ref: reference end-effector positions, shape (N, 3) [m].
         error: tracking error |x - x_ref|, shape (N,) [m].
-        clearance: smallest clearance (to obstacles and, with self-collision on, between
-            link pairs), shape (N,) [m] (inf without any).
+        clearance: smallest link-obstacle clearance, shape (N,) [m] (inf without any).
         visuals: link name -> its meshes and their poses in the link frame.
         d_min: the planner's safety distance [m] (0 when the config gives none).
         obstacle_track: obstacle name -> its recorded pose per sample, shape (N, 7): x, y, z
@@ -150,7 +149,7 @@ class RunData:
         poses = self.obstacle_poses(k)
         obstacles = [Obstacle(o.name, o.parts, poses[o.name]) for o in self.scene.obstacles]
         return Scene(self.scene.robot, obstacles, self.scene.broadphase, self.scene.metric,
-                     self.scene.self_pair_names)  # fmt: skip
+                     self.scene.self_pair_names, self.scene.self_d_min)  # fmt: skip
 
 
 class RunFolderError(ConfigError):

@@ -14,7 +14,8 @@ from typing import Any
 from pydantic import model_validator
 
 from articula.errors import ConfigError, InfeasibleError
-from articula.loops.tracking import trace_columns, track, tracking_metrics
+from articula.loops.tracking import Trajectory, trace_columns, track, tracking_metrics
+from articula.planning.approach import approach
 from articula.planning.config import (
     PlannerSpec,
     TrajectorySpec,
@@ -23,6 +24,7 @@ from articula.planning.config import (
     make_targets,
 )
 from articula.planning.reach import check_reach
+from articula.planning.task import Target
 from articula.runs.registry import Experiment, Progress, Result
 from articula.scene.config import SceneSpec, build_scene
 from articula.validation import Seed, fields_as, load_toml
@@ -88,13 +90,30 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
     with fields_as(_CONFIG_PATHS):
         check_reach(scene.robot, targets.positions, p.duration)
         planner = make_planner(p, scene, config.seed)
-        run = track(planner, targets, q0, p.dt, p.duration, p.max_steps, progress)
+        reference: Trajectory = targets
+        lead = 0.0
+        if p.approach == "auto":
+            pose = scene.robot.ee_pose(scene.robot.check_q(q0, "q0"))
+            tool = Target(pose[:3, 3], pose[:3, :3], pose[:3, :3] @ planner.task.tool_axis)
+            reference = approach(targets, tool, p.approach_speed, p.approach_turn_rate)
+            lead = reference.duration
+        run = track(planner, reference, q0, p.dt, lead + p.duration, p.max_steps, progress,
+                    lead)  # fmt: skip
     metrics = tracking_metrics(run, scene.robot, p.settle or 0.0, planner.iterations, targets.cone)
+    after = f"{p.settle} s into the path" if lead else f"{p.settle} s"
     if metrics["rms_error"] > p.tolerance:
         raise InfeasibleError(
-            f"not tracked: rms error {metrics['rms_error']:.3g} m after {p.settle} s (max "
+            f"not tracked: rms error {metrics['rms_error']:.3g} m after {after} (max "
             f"{metrics['max_error']:.3g} m) exceeds planner.tolerance = {p.tolerance} m; the "
             "path may be out of reach or blocked",
+            "trajectory",
+        )
+    turned = metrics.get("rms_orientation_error")
+    if turned is not None and turned > p.orientation_tolerance:
+        raise InfeasibleError(
+            f"not tracked: rms orientation error {turned:.3g} rad after {after} (max "
+            f"{metrics['max_orientation_error']:.3g} rad) exceeds planner.orientation_tolerance "
+            f"= {p.orientation_tolerance} rad",
             "trajectory",
         )
     return Result(metrics, trace_columns(run))

@@ -75,8 +75,9 @@ def plan_config(run: Run) -> dict[str, Any]:
     Its meshes are named inside the package (package://articula/...), so that the config, its
     hash and its run folder are the same on every machine and install; a seed override goes
     to the top of the config; the tolerance is lifted so that every result is reported,
-    however large its error, instead of refused; BAORNN runs without joint speed limits, as
-    the book's does (the baselines' solvers keep them).
+    however large its error, instead of refused; BAORNN runs without joint speed or
+    acceleration limits and the path starts at once wherever the tool is, as the book's does
+    (the baselines' solvers keep the speed limits).
     """
     data = {"experiment": NAME, **load_toml(scene_path(run.scene))}
     for obstacle in data.get("obstacles", []):
@@ -85,8 +86,10 @@ def plan_config(run: Run) -> dict[str, Any]:
     overrides = dict(run.overrides)
     if "seed" in overrides:
         data["seed"] = overrides.pop("seed")
-    # The book's Algorithm 1 has no joint speed limits: its runs keep none (limits = "none").
-    data["planner"] = {**data["planner"], **overrides, "tolerance": 1e3, "limits": "none"}
+    # The book's Algorithm 1 has no joint limits on speed or acceleration and starts the path at
+    # once: its runs keep none (limits = "none") and have no approach.
+    data["planner"] = {**data["planner"], **overrides, "tolerance": 1e3, "limits": "none",
+                       "approach": "none"}  # fmt: skip
     return data
 
 

@@ -1,0 +1,149 @@
+"""What the resolved-rate planners (pinv, dls, qp) share: the period's reachable box from the
+joint speed, acceleration and position limits, the measured motion, and a check that a step
+keeps d_min and self_d_min."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from articula.planning.clearance import ClearanceRows, RowSource
+from articula.planning.objective import braking_travel
+from articula.planning.rate_limits import RateLimits
+from articula.planning.task import Target
+from articula.scene.scene import Scene
+
+BACKTRACKS = 3  # halvings of a step that breaks a clearance before the arm brakes instead
+
+
+class ResolvedRate:
+    """A base for the resolved-rate planners: their limits, measured motion and clearance check.
+
+    The subclasses are dataclasses that hold `scene`, `dt`, `d_min`, `rate`, `infeasible`,
+    `_previous` and `_rows`, and call `_set_limits` after construction; this base reads them.
+    """
+
+    scene: Scene
+    dt: float
+    d_min: float
+    rate: RateLimits | None
+    iterations: int
+    infeasible: int
+    _previous: Target | None
+    _rows: RowSource
+    _limits: RateLimits
+
+    def reset(self) -> None:
+        """Forget the previous target and motion: no feed-forward, the arm at rest."""
+        self._previous = None
+        self._limits.reset()
+
+    def follow(self, motion: np.ndarray) -> None:
+        """Take the arm's measured joint motion [rad] over the period that ended as its motion:
+        the next period's limits hold relative to it.
+
+        Args:
+            motion: the measured joint displacement over the last period, shape (nq,) [rad].
+        """
+        self._limits.record(motion)
+
+    def warm_up(self, q: np.ndarray, target: Target) -> None:
+        """Compile (or load) the kernels of a step, and of its clearance check, by taking one;
+        the counts are put back (reset() forgets the step's motion).
+
+        Args:
+            q: a configuration to step from, shape (nq,) [rad].
+            target: a target to step toward.
+        """
+        counts = (self.iterations, self.infeasible)
+        self.step(q.copy(), target, 0.0)
+        self._clearances(q, 0.0)
+        self.iterations, self.infeasible = counts
+
+    def step(self, q: np.ndarray, target: Target, t: float) -> np.ndarray:
+        """One control period (the subclass's).
+
+        Args:
+            q: joint angles at the start of the period, shape (nq,) [rad].
+            target: the period's target.
+            t: time of the period, placing moving obstacles [s].
+
+        Returns:
+            The joint angles after dt, shape (nq,) [rad].
+        """
+        raise NotImplementedError
+
+    def _set_limits(self, speed_scale: float) -> None:
+        """The limits the steps keep: `rate`, or without it the URDF's speed limits times
+        speed_scale (the solvers always keep those)."""
+        if self.rate is None:
+            speeds = self.scene.robot.velocity_limit
+            self._limits = RateLimits(speed_scale * np.where(speeds > 0, speeds, np.inf), self.dt)
+        else:
+            self._limits = self.rate
+
+    def _box(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The configurations this period can reach from q [rad] within every limit."""
+        robot = self.scene.robot
+        return self._limits.box(q, robot.lower, robot.upper)
+
+    def _finish(
+        self,
+        q: np.ndarray,
+        q_new: np.ndarray,
+        box: tuple[np.ndarray, np.ndarray],
+        rows: ClearanceRows,
+        t: float,
+        strained: bool = False,
+    ) -> np.ndarray:
+        """The period's configuration: q_new within the box, kept if its clearances hold (or
+        grow), else halved toward braking, else braking (counted as infeasible); the motion
+        remembered for the acceleration limit."""
+        q_new = np.clip(q_new, *box)
+        if rows.distance.size:  # something is within the influence distance: check the step
+            q_new, held = self._clear_step(q, q_new, np.clip(q, *box), t)
+            strained = strained or not held
+        if strained or self._limits.strained:
+            self.infeasible += 1
+        self._limits.record(q_new - q)
+        return q_new
+
+    def _clear_step(
+        self, q: np.ndarray, q_new: np.ndarray, brake: np.ndarray, t: float
+    ) -> tuple[np.ndarray, bool]:
+        """(the first of q_new, its halvings toward `brake`, `brake` itself whose clearances,
+        there and where braking from it ends, are above d_min and self_d_min or no lower than
+        at q; whether one was)."""
+        floors = np.array([self.d_min, self.scene.self_d_min])
+        now = None
+        candidate = q_new
+        for k in range(BACKTRACKS + 2):
+            if k == BACKTRACKS + 1:
+                candidate = brake
+            clear = self._clearances_braking(q, candidate, t)
+            if np.all(clear > floors):
+                return candidate, True
+            if now is None:
+                now = self._clearances(q, t)
+            if np.all((clear > floors) | (clear >= now)):
+                return candidate, True
+            candidate = brake + 0.5 * (candidate - brake)
+        return brake, False
+
+    def _clearances_braking(self, q: np.ndarray, q_new: np.ndarray, t: float) -> np.ndarray:
+        """(link-obstacle, self) clearance [m] at q_new and, with acceleration limits, at the
+        point where braking from the motion q → q_new ends: the smaller of the two."""
+        clear = self._clearances(q_new, t)
+        change = self._limits.change
+        if change is not None:
+            end = q_new + braking_travel(q_new - q, change)
+            clear = np.minimum(clear, self._clearances(end, t))
+        return clear
+
+    def _clearances(self, q: np.ndarray, t: float) -> np.ndarray:
+        """(link-obstacle, self) clearance at q [m], compiled where the scene allows it."""
+        compiled = self._rows.compiled
+        if compiled is not None:
+            compiled.at(t)
+            d, d_self, _, _ = compiled.evaluate(q)
+            return np.array([d, d_self])
+        return np.array(self.scene.clearances(q, t))
