@@ -219,3 +219,25 @@ def test_ee_offset_on_an_unknown_frame_names_ee_frame(small_arm):
             small_arm["urdf"], [small_arm["pkg"]], ee_frame="gripper", ee_offset=np.eye(4)
         )
     assert err.value.field == "ee_frame"
+
+
+def test_a_continuous_joint_turns_through_pi_the_short_way(build_edited):
+    """From 3.1 rad to a tool position that needs 3.3 rad (−2.98 wrapped): the commands pass
+    through π a little at a time, wrapped, within the joint's speed limit."""
+    from articula.loops.online import OnlineController
+    from articula.planning.config import PlannerSpec
+    from articula.scene import Scene
+
+    robot = build_edited(*CONTINUOUS_J2)
+    start = np.array([0.4, 3.1, 0.1])
+    goal = robot.ee_position(np.array([0.4, 3.3, 0.1]))
+    controller = OnlineController.from_spec(Scene(robot, []), PlannerSpec(method="qp", dt=0.01))
+    q = [controller.reset(start)]
+    for _ in range(300):
+        q.append(controller.step(goal))
+    q = np.array(q)
+    assert np.all(np.abs(q[:, 1]) <= math.pi)  # wrapped
+    assert q[-1, 1] == pytest.approx(3.3 - 2 * math.pi, abs=1e-3)  # there, the short way
+    motion = robot.difference(q[1:], q[:-1])
+    assert np.abs(motion[:, 1]).max() <= robot.velocity_limit[1] * 0.01 * (1 + 1e-9)
+    assert np.abs(motion[:, 1]).sum() < 1.0  # not the long way round, 2π − 0.2 rad

@@ -115,3 +115,70 @@ def test_allowed_pairs_are_not_checked_and_bad_names_are_refused():
 def test_the_same_matrix_for_the_same_seed():
     first = self_collision_matrix(ROBOT, samples=200, seed=9)
     assert first == self_collision_matrix(ROBOT, samples=200, seed=9)
+
+
+def chain_robot(tmp_path, links: int) -> RobotModel:
+    """A chain of `links` boxes, 0.1 m apart on revolute joints about x and y in turn (±2.6 rad),
+    so that links some way apart can fold onto each other."""
+    body = "".join(
+        f'<link name="l{i}"><collision><origin xyz="0 0 0.05"/><geometry>'
+        '<box size="0.03 0.03 0.09"/></geometry></collision></link>'
+        for i in range(links)
+    )
+    body += "".join(
+        f'<joint name="j{i}" type="revolute"><parent link="l{i}"/><child link="l{i + 1}"/>'
+        f'<origin xyz="0 0 0.1"/><axis xyz="{"0 1 0" if i % 2 else "1 0 0"}"/>'
+        '<limit lower="-2.6" upper="2.6" effort="1" velocity="1"/></joint>'
+        for i in range(links - 1)
+    )
+    path = tmp_path / "chain.urdf"
+    path.write_text(f'<robot name="chain">{body}</robot>')
+    return RobotModel.from_urdf(path, max_links=links)
+
+
+def test_the_sphere_bounds_decide_as_the_exact_distances_on_every_sample(tmp_path):
+    """On a 24-link chain the matrix equals the one brute force gives: every candidate pair's
+    exact distance at every sample (the bounds only spare the queries they rule out)."""
+    robot = chain_robot(tmp_path, 24)
+    matrix = self_collision_matrix(robot, samples=150, margin=0.02, seed=2)
+    names = [link.name for link in robot.links]
+    candidates = [pair for pair in itertools.combinations(names, 2)
+                  if matrix.skipped.get(pair) != "adjacent"]  # fmt: skip
+    scene = Scene(robot, [], self_pairs=candidates)
+    Q = np.random.default_rng(2).uniform(*robot.sample_range, (150, robot.nq))
+    D = np.array([scene.self_distances(q) for q in Q])
+    for pair, column in zip(scene.self_pair_names, D.T, strict=True):
+        expected = ("never close" if column.min() > 0.02
+                    else "always touching" if column.max() <= 0.0 else None)  # fmt: skip
+        assert matrix.skipped.get(pair) == expected, pair
+    assert matrix.checked  # the chain does fold onto itself
+
+
+def test_the_matrix_is_kept_on_disk_and_read_back(tmp_path, monkeypatch):
+    monkeypatch.setenv("ARTICULA_CACHE_DIR", str(tmp_path / "cache"))
+    first = self_collision_matrix(ROBOT, samples=100, seed=1)
+    (kept,) = (tmp_path / "cache").glob("self_collision-*.json")
+
+    def not_again(*args, **kwargs):
+        raise AssertionError("computed again instead of read from the cache")
+
+    monkeypatch.setattr("articula.scene.self_collision._decide", not_again)
+    assert self_collision_matrix(ROBOT, samples=100, seed=1) == first
+    with pytest.raises(AssertionError, match="computed again"):  # other settings: another key
+        self_collision_matrix(ROBOT, samples=101, seed=1)
+    kept.write_text("{not json")  # a damaged file is computed again, not trusted
+    monkeypatch.undo()
+    monkeypatch.setenv("ARTICULA_CACHE_DIR", str(tmp_path / "cache"))
+    assert self_collision_matrix(ROBOT, samples=100, seed=1) == first
+
+
+def test_pairs_left_undecided_by_the_query_budget_are_checked(tmp_path, monkeypatch):
+    robot = chain_robot(tmp_path, 16)
+    full = self_collision_matrix(robot, samples=100, seed=3)
+    monkeypatch.setenv("ARTICULA_CACHE_DIR", str(tmp_path / "other"))
+    monkeypatch.setattr("articula.scene.self_collision.MAX_QUERIES", 50)
+    bounded = self_collision_matrix(robot, samples=100, seed=3)
+    assert set(full.checked) < set(bounded.checked)  # the safe side: more pairs checked
+    assert {p for p, why in bounded.skipped.items() if why == "never close"} <= {
+        p for p, why in full.skipped.items() if why == "never close"
+    }

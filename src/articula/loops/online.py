@@ -9,7 +9,7 @@ and a planned run share one code path:
         q = controller.step(target, {"box": pose_from_camera}, q_measured=read_joints())
         send q to the arm
     (target: a position [m], a 4×4 pose for a pose task, or a Target; without q_measured the
-    controller plans from its own last command)
+    tool's lag behind the commands is not corrected)
 """
 
 from __future__ import annotations
@@ -24,6 +24,10 @@ from articula.planning.planner import Planner
 from articula.planning.task import Target, unit
 from articula.scene.obstacles import Obstacle, check_pose
 from articula.scene.scene import Scene
+
+
+MAX_LEAD = 0.05  # [m] the largest correction of a target for the tool's lag (anti-windup)
+LEAD_TIME = 1.0  # [s] time constant of that correction: the measured error integrated over it
 
 
 class LivePose:
@@ -64,6 +68,8 @@ class OnlineController:
         q: the last commanded joint positions, shape (n,) [rad]; None before reset.
         q_measured: the last measured joint positions (the start after reset), shape (n,)
             [rad]; None before reset.
+        lead: how far [m] the targets are moved to make up for the measured tool's lag behind
+            them (its error integrated over LEAD_TIME), shape (3,).
         held: the start's tool pose, whose orientation and axis fill in what a target lacks.
         target: the last period's target, completed.
     """
@@ -79,6 +85,7 @@ class OnlineController:
         self.periods = 0  # since reset; the time is periods · dt [s]
         self.q: np.ndarray | None = None
         self.q_measured: np.ndarray | None = None
+        self.lead = np.zeros(3)
         self.held: Target | None = None  # the start's orientation and tool axis
         self.target: Target | None = None  # the last period's, complete
 
@@ -165,6 +172,7 @@ class OnlineController:
             moving = robot.check_q(velocity, "velocity")
             self.planner.follow(moving * self.dt)
         self.q, self.q_measured, self.periods = start, start.copy(), 0
+        self.lead = np.zeros(3)
         return start.copy()
 
     def step(
@@ -175,9 +183,12 @@ class OnlineController:
     ) -> np.ndarray:
         """One control period toward the target; obstacle_poses moves live obstacles first.
 
-        With q_measured the period plans from the arm's measured joints instead of the last
-        command, and the speed and acceleration limits hold relative to the measured motion
-        (since the last measurement, or the start).
+        The commands form one continuous stream within the speed and acceleration limits
+        (what an arm's controller checks), each planned from the one before. With q_measured
+        the loop closes on the arm: the targets move ahead by the measured tool's error
+        integrated over LEAD_TIME (at most MAX_LEAD), so the measured tool converges to the
+        path while a servo that lags gets commands ahead of it (a plan from the measured joints
+        would hold a lagging servo back: docs/deviations.md).
 
         Args:
             target: a position (3,) [m], a pose (4×4, world) or a Target; an orientation or
@@ -185,7 +196,7 @@ class OnlineController:
             obstacle_poses: live obstacle name -> its new pose (4×4, world) [m]; None: none
                 moves.
             q_measured: the arm's joint positions measured at the start of the period, shape
-                (n,) [rad]; None: plan from the last command.
+                (n,) [rad]; None: the lag found last (none before any measurement) stays.
 
         Returns:
             The new joint positions to send to the arm, shape (n,) [rad] (continuous joints
@@ -206,11 +217,17 @@ class OnlineController:
                 self.live[name].pose = check_pose(f"obstacle {name!r}", pose)
             except GeometryError as exc:
                 raise ConfigError(f"obstacle_poses.{name}", str(exc)) from None
-        self.target = self._complete(target)
         if measured is not None:
-            self.planner.follow(robot.difference(measured, self.q_measured))
-            self.q, self.q_measured = measured, measured
-        self.q = robot.wrap(self.planner.step(self.q, self.target, self.t))
+            self.q_measured = measured
+            if self.target is not None:  # the last period's target, which the arm measured aims at
+                error = self.target.position - robot.ee_position(measured)
+                lead = self.lead + self.dt / LEAD_TIME * error
+                self.lead = lead * min(1.0, MAX_LEAD / max(float(np.linalg.norm(lead)), 1e-12))
+        self.target = self._complete(target)
+        led = self.target
+        if self.lead.any():
+            led = Target(self.target.position + self.lead, self.target.rotation, self.target.axis)
+        self.q = robot.wrap(self.planner.step(self.q, led, self.t))
         self.periods += 1
         return self.q.copy()
 
