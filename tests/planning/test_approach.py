@@ -32,7 +32,7 @@ def test_the_approach_starts_at_the_tool_and_ends_at_rest_on_the_path():
 
 
 def test_a_path_that_starts_at_the_tool_needs_no_approach():
-    near = CIRCLE(0.0) + [0.5 * NEAR, 0.0, 0.0]
+    near = CIRCLE(0.0) + np.array([0.5 * NEAR, 0.0, 0.0])
     assert approach(CIRCLE, Target(near), 0.25, 0.5).duration == 0.0
 
 

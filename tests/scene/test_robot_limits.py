@@ -8,12 +8,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from articula.book.ch1.experiment import PlanConfig, run_plan
 from articula.errors import ConfigError, InfeasibleError
 from articula.loops.online import OnlineController
 from articula.planning.config import PlannerSpec
 from articula.scene.config import build_scene, load_scene_spec
 from articula.validation import parse_model
-from articula.book.ch1.experiment import PlanConfig, run_plan
 
 
 def scene(**robot):
@@ -73,7 +73,7 @@ def test_a_pose_task_off_its_orientation_is_not_tracked():
                            "times": [0.0, 1.0], "rpy": [1.0, 0.0, 0.0]},
             "planner": {"method": "baornn-improved", "task": "pose", "orientation_weight": 0.0,
                         "duration": 2.0, "settle": 1.0}}  # fmt: skip
-    with pytest.raises(InfeasibleError, match="planner.orientation_tolerance"):
+    with pytest.raises(InfeasibleError, match=r"planner\.orientation_tolerance"):
         run_plan(parse_model(PlanConfig, data))
     data["planner"]["orientation_tolerance"] = 3.0
     run_plan(parse_model(PlanConfig, data))  # within the tolerance it is given

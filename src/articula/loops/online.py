@@ -25,7 +25,6 @@ from articula.planning.task import Target, unit
 from articula.scene.obstacles import Obstacle, check_pose
 from articula.scene.scene import Scene
 
-
 MAX_LEAD = 0.05  # [m] the largest correction of a target for the tool's lag (anti-windup)
 LEAD_TIME = 1.0  # [s] time constant of that correction: the measured error integrated over it
 
