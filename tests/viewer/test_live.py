@@ -88,7 +88,12 @@ def test_the_panel_rebuilds_the_controller_and_refuses_a_start_within_d_min(serv
     live.method.value = "baornn-improved"
     live.rebuild()
     assert type(live.controller.planner).__name__ == "ImprovedBaornn"
-    live.period()
+    for _ in range(5):
+        live.period()
+    # The new controller took the arm's motion: the acceleration limit held across the switch.
+    q = np.array(live.recording.q)
+    acceleration = np.abs(np.diff(q, 2, axis=0)) / live.dt**2
+    assert np.all(acceleration <= live.scene.robot.acceleration_limit * (1 + 1e-9))
     old = live.controller
     live.d_min.value = 5.0  # farther than any obstacle is
     live.rebuild()

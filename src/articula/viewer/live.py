@@ -173,14 +173,19 @@ class Live:
         return PlannerSpec(**(self.config["planner"] | panel))
 
     def rebuild(self) -> None:
-        """A new controller from the panel's settings, started from the arm where it is; on
-        a start it refuses (within the new d_min, say) the old one goes on."""
+        """A new controller from the panel's settings, started from the arm where it is and
+        as it moves (its acceleration limit holds across the change); on a start it refuses
+        (within the new d_min, say) the old one goes on."""
         try:
             spec = self.spec()
             seed = int(spec.seed or 0)
             controller = OnlineController.from_spec(self.scene, spec, seed, live_obstacles=True)
             self._push_poses(controller)
-            controller.reset(self.q)
+            q = self.recording.q
+            velocity = None
+            if len(q) >= 2:
+                velocity = self.scene.robot.difference(q[-1], q[-2]) / self.dt
+            controller.reset(self.q, velocity)
         except ArticulaError as exc:
             if self.controller is None:
                 raise  # the scene file's own settings do not start: nothing to show
