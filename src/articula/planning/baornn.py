@@ -11,6 +11,7 @@ from pydantic import Field
 
 from articula.planning import baornn_kernel as kernel
 from articula.planning.objective import NO_STOP, Box, Objective, Stop
+from articula.planning.planner import WARM_UP_STEPS
 from articula.planning.rate_limits import RateLimits
 from articula.planning.task import Target, Task, as_target
 from articula.scene.scene import Scene
@@ -63,8 +64,9 @@ class BeetleSearch:
             self.rate.reset()
 
     def warm_up(self, q: np.ndarray, target: Target) -> None:
-        """Compile (or load) the kernels of a step by taking one; the counts and the random
-        state are put back (reset() forgets the step's motion).
+        """Compile (or load) the kernels of a step by taking WARM_UP_STEPS of them (the
+        interpreter specialises what runs a few times); the counts and the random state are put
+        back (reset() forgets the steps' motion).
 
         Args:
             q: a configuration to step from, shape (nq,) [rad].
@@ -72,7 +74,8 @@ class BeetleSearch:
         """
         state = self.rng.bit_generator.state
         counts = (self.evaluations, self.iterations, self.infeasible)
-        self.step(q.copy(), target, 0.0)
+        for _ in range(WARM_UP_STEPS):
+            self.step(q.copy(), target, 0.0)
         self.rng.bit_generator.state = state
         self.evaluations, self.iterations, self.infeasible = counts
 

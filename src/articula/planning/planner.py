@@ -9,6 +9,8 @@ import numpy as np
 from articula.planning.task import Target, Task
 from articula.scene.scene import Scene
 
+WARM_UP_STEPS = 3  # steps a warm-up takes: the first compiles, the next let Python specialise
+
 
 class Planner(Protocol):
     """One control period at a time: from q [rad] toward the target."""

@@ -8,6 +8,7 @@ import numpy as np
 
 from articula.planning.clearance import ClearanceRows, RowSource
 from articula.planning.objective import braking_travel
+from articula.planning.planner import WARM_UP_STEPS
 from articula.planning.rate_limits import RateLimits
 from articula.planning.task import Target
 from articula.scene.scene import Scene
@@ -47,15 +48,17 @@ class ResolvedRate:
         self._limits.record(motion)
 
     def warm_up(self, q: np.ndarray, target: Target) -> None:
-        """Compile (or load) the kernels of a step, and of its clearance check, by taking one;
-        the counts are put back (reset() forgets the step's motion).
+        """Compile (or load) the kernels of a step, and of its clearance check, by taking
+        WARM_UP_STEPS of them (the interpreter specialises what runs a few times); the counts
+        are put back (reset() forgets the steps' motion).
 
         Args:
             q: a configuration to step from, shape (nq,) [rad].
             target: a target to step toward.
         """
         counts = (self.iterations, self.infeasible)
-        self.step(q.copy(), target, 0.0)
+        for _ in range(WARM_UP_STEPS):
+            self.step(q.copy(), target, 0.0)
         self._clearances(q, 0.0)
         self.iterations, self.infeasible = counts
 
