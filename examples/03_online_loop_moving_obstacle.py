@@ -80,7 +80,7 @@ def main():
     scene = Scene(robot, [Obstacle("ball", (sphere(0.08),), pose(ball_position(0.0, duration)))])
     logs = {method: run_loop(method, scene, duration) for method in METHODS}
 
-    print(f"compute time per {1e3 * DT:g} ms period, without the first (it loads the kernels)")
+    print(f"compute time per {1e3 * DT:g} ms period, without the first (shown apart)")
     print(ROW.format("method", "mean [ms]", "p99 [ms]", "max [ms]", "late",
                      "clearance [mm]", "max error [mm]"))  # fmt: skip
     for method, log in logs.items():
@@ -90,7 +90,8 @@ def main():
                          f"{ms.max():.2f}", late, f"{1e3 * log['clearance'].min():.1f}",
                          f"{1e3 * log['error'].max():.3f}"))  # fmt: skip
     first = ", ".join(f"{m} {1e3 * log['compute'][0]:.0f} ms" for m, log in logs.items())
-    print(f"first period: {first}; error: the tool's largest distance from its target; "
+    print(f"first period (reset() compiled the kernels): {first}; error: the tool's largest "
+          "distance from its target; "
           f"d_min = {1e3 * D_MIN:g} mm")  # fmt: skip
 
     fig = Figure(figsize=(9, 7), layout="constrained")

@@ -59,7 +59,12 @@ def plan(
         )  # fmt: skip
         speed = f"{m['time_per_iteration_us']:.1f} µs per iteration"
         error = f"{1e3 * m['rms_error']:.3f} mm, max {1e3 * m['max_error']:.3f} mm"
-        out.print(f"RMS error after {m['settle_s']:g} s: {error}; {clearance}; {speed}; "
+        settled = f"after {m['settle_s']:g} s"
+        if m.get("approach_s"):
+            settled = (
+                f"{m['settle_s']:g} s into the path (after a {m['approach_s']:.2g} s approach)"
+            )
+        out.print(f"RMS error {settled}: {error}; {clearance}; {speed}; "
                   f"written to {out_dir}")  # fmt: skip
     if m["collisions"] and not allow_collisions:
         from articula.errors import CollisionError

@@ -242,13 +242,19 @@ class OnlineController:
                 target = Target(arr[:3, 3].copy(), arr[:3, :3].copy())
             else:
                 target = Target(arr)
-        position = np.asarray(target.position, dtype=float)
+        # C-ordered copies: the compiled kernels are compiled for those (a strided view, such as
+        # a column of a pose, would compile them again in the middle of a run).
+        position = np.ascontiguousarray(target.position, dtype=float)
         if position.shape != (3,) or not np.isfinite(position).all():
             raise ConfigError(
                 "target", f"needs 3 finite coordinates [m] or a 4×4 pose (got {position.tolist()})"
             )
         held = self.held
-        rotation = held.rotation if target.rotation is None else target.rotation
+        rotation = (
+            held.rotation
+            if target.rotation is None
+            else np.ascontiguousarray(target.rotation, dtype=float)
+        )
         axis = held.axis if target.axis is None else unit(target.axis, "target.axis")
         return Target(position, rotation, axis)
 

@@ -332,7 +332,7 @@ class RobotModel:
         Returns:
             The end-effector position, shape (3,) [m].
         """
-        return self.ee_pose(q)[:3, 3]
+        return self.ee_pose(q)[:3, 3].copy()
 
     def link_poses(self, q: Sequence[float] | np.ndarray) -> dict[str, np.ndarray]:
         """Pose (4×4, world) of every body frame, by link name.
