@@ -63,7 +63,7 @@ class ResetAt:
 
     def __init__(self, at: int) -> None:
         self.plant, self.at, self.periods = PneuNetPins(), at, 0
-        self.tick_us = self.plant.tick_us
+        self.tick_us, self.program = self.plant.tick_us, self.plant.program
         self.rig: FirmwareRig | None = None
 
     def start(self, seed: int) -> None:

@@ -108,7 +108,7 @@ def test_rig_info_of_an_emulated_pneunet(emulated_pneunet, cli):
     proc = cli("rig", "info", emulated_pneunet, "--json")
     assert proc.returncode == 0, proc.stderr
     info = json.loads(proc.stdout)
-    assert info["rig"] == "pneunet" and info["protocol"] == 1
+    assert info["rig"] == "pneunet" and info["protocol"] == 2 and info["reset"] == "power-on"
     assert [c["unit"] for c in info["channels"]] == ["deg", "deg", "counts"]
     text = cli("rig", "info", emulated_pneunet).stdout
     assert "angle [deg]" in text

@@ -153,12 +153,14 @@ def info(port: Port, as_json: JsonFlag = False) -> None:
         "firmware": ".".join(map(str, i.firmware)),
         "sample_period_s": i.sample_period_us * 1e-6,
         "channels": [{"name": c.name, "unit": c.unit} for c in i.channels],
+        "reset": i.reset.name.lower().replace("_", "-"),
     }
     if as_json:
         emit_json(summary)
         return
     out.print(f"{summary['rig']} rig on {port}: protocol {i.protocol}, firmware "
-              f"{summary['firmware']}, a sample every {i.sample_period_us} µs")  # fmt: skip
+              f"{summary['firmware']}, a sample every {i.sample_period_us} µs, started by "
+              f"{summary['reset']}")  # fmt: skip
     for c in i.channels:
         out.print(escape(f"  {c.name} [{c.unit}]"))
 
