@@ -295,8 +295,8 @@ static void run_checks(void) {
     }
     if (!running) return;
     rig_event = 0;
-    const char *why = rig->control();
-    if (why) end_run(ENDED_ERROR, why);
+    const char *reason = rig->control();
+    if (reason) end_run(ENDED_ERROR, reason);
     else if (finished) end_run(ENDED_DONE, 0);
     else if ((uint16_t)(rig_clock_ms() - heard_ms) >= host_timeout_ms)
         end_run(ENDED_HOST, "no frame from the host within host_timeout_ms; outputs off");

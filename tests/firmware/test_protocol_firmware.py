@@ -118,8 +118,8 @@ def error_texts() -> list[str]:
     texts = []
     for source in sorted(SOURCES.glob("*.c")):
         code = source.read_text()
-        for call in re.findall(r"\b(?:send_error|end_run)\(([^;]*)\);", code):
-            if call.rsplit(",", 1)[-1].strip() in ("why", "0"):
+        for call in re.findall(r"(?<!void )\b(?:send_error|end_run)\(([^;]*)\);", code):
+            if call.rsplit(",", 1)[-1].strip() in ("why", "reason", "0"):
                 continue  # a hook's reason (its *why or return, below), or an end without one
             assert re.search(LITERAL, call), f"{source.name}: send_error({call}) without a text"
             texts.append("".join(re.findall(LITERAL, call)))
