@@ -11,6 +11,10 @@
  * read of UDR0 goes through simavr (its own pacing of reads turned off), then the byte in
  * the shift register moves up, and RXC0's interrupt comes again while a byte is left. Bytes that reach a disabled receiver are lost, as on the chip.
  *
+ * The host's bytes reach the line in batches at the USB bridge's 1 ms frames, at a phase
+ * drawn for each batch (the USB clock is not the board's), so a host's command meets the
+ * firmware at any point of its control period.
+ *
  * The trace (--trace) has a line per host frame as its delimiter ends on the line ("rx"),
  * per firmware frame as its delimiter goes into UDR0 ("tx"), and per lost byte. */
 #include <errno.h>
@@ -34,7 +38,8 @@ DEFINE_FIFO(uint16_t, uart_fifo);
 #define RXEN0 0x10
 #define DOR0 0x08
 #define BYTE_CYCLES 160     /* a byte's time on the line at 1 Mbaud (8N1: 10 bits) */
-#define POLL_CYCLES 1600    /* the pty is served every 100 µs of simulated time, on average */
+#define POLL_CYCLES 1600    /* the pty is served every 100 µs of simulated time */
+#define USB_FRAME_CYCLES 16000 /* the USB bridge's 1 ms frames */
 #define QUEUE 65536         /* bytes each way between the pty and the UART */
 #define OUT_HIGH_WATER 4096 /* the simulation waits for the host above this */
 #define FRAME_TRACE 1024    /* bytes of a frame the trace shows */
@@ -54,7 +59,7 @@ static void *simavr_read_param;
 static int on_line, in_shift;
 static uint8_t line_byte, shift_byte;
 static avr_cycle_count_t heard;
-static uint32_t jitter = 12345; /* the pty's serving times, spread (a fixed seed) */
+static uint32_t jitter = 12345; /* the USB frame's phase, drawn (a fixed seed) */
 struct frame_text {
     char hex[2 * FRAME_TRACE + 1];
     int length;
@@ -157,13 +162,13 @@ static avr_cycle_count_t serve_pty(avr_t *a, avr_cycle_count_t when, void *param
         poll(&waiting, 1, 100);
         exit_without_plant();
     }
-    if (queue_size(&to_avr) && !avr_cycle_timer_status(avr, uart_line, NULL))
-        avr_cycle_timer_register(avr, BYTE_CYCLES, uart_line, NULL);
-    if (!running) return when + 10 * POLL_CYCLES;
-    /* During a run, at times spread over 0.5-1.5 of the mean, so that the host's commands
-     * reach the firmware at every phase of its control period. */
-    jitter = jitter * 1103515245u + 12345u;
-    return when + POLL_CYCLES / 2 + (jitter >> 8) % POLL_CYCLES;
+    /* New bytes from the host wait for the USB bridge's next 1 ms frame, whose clock is not
+     * the board's: they reach the line at any phase of the firmware's control period. */
+    if (queue_size(&to_avr) && !avr_cycle_timer_status(avr, uart_line, NULL)) {
+        jitter = jitter * 1103515245u + 12345u;
+        avr_cycle_timer_register(avr, BYTE_CYCLES + (jitter >> 8) % USB_FRAME_CYCLES, uart_line, NULL);
+    }
+    return when + (running ? POLL_CYCLES : 10 * POLL_CYCLES);
 }
 
 void line_open(char *path, size_t size) {
