@@ -17,9 +17,9 @@
  * writes
  *     sample <adc channel> <PORTA> <PORTC> <PORTH> <OCR1A> <OCR3A> <OCR4A> <cycles> <latency>
  * (the output registers as the firmware left them; the CPU cycles of the previous control
- * step: its marked interrupts, entry to return, and its main-loop part between its marks
- * less the interrupts that came meanwhile; and its latency: from the interrupt mark before
- * that part began to its end, everything included) and waits
+ * step: the time its marked interrupts ran, the interrupts nested in them not counted; and
+ * its latency: the longest from a marked interrupt's entry to its reti, nested ones
+ * included) and waits
  * for "<adc code> <encoder count> [<hex bytes>]": the code the conversion reads, the count
  * the quadrature encoder on D2/D3 (PE4/PE5) reaches, one edge every EDGE_CYCLES, and bytes a
  * sensor sends on Serial1 (RX1, at 115 200 baud). With --tick-us the plant has its own step
@@ -87,10 +87,11 @@ static struct {
     uint8_t data[SENSOR_QUEUE];
     uint32_t head, tail;
 } to_sensor;
-/* The control step's cycles: its marked interrupts (entry to reti), its main-loop part
- * between its marks, and the latency from the last interrupt mark to that part's end. */
-static avr_cycle_count_t step_cycles, step_latency, entered[64], main_since, isr_mark, main_from;
-static avr_cycle_count_t in_interrupts, interrupt_since, main_interrupts; /* all of them */
+/* The control step's cycles: the time its marked interrupts ran themselves (not the ones
+ * nested in them), and its latency: the longest from a marked interrupt's entry to its reti,
+ * the nested ones included. The interrupt running now (0: the main loop), since when. */
+static avr_cycle_count_t step_cycles, step_latency, entered[64], top_since;
+static uint8_t top;
 static uint8_t step_vector[64];
 static volatile sig_atomic_t reset_pressed, hang_pressed; /* SIGUSR1, SIGUSR2 */
 static avr_flashaddr_t hang_at;                            /* the firmware's `rjmp .` */
@@ -205,21 +206,20 @@ static void vector_running(avr_irq_t *irq, uint32_t value, void *param) {
     (void)irq;
     uint8_t vector = (uint8_t)(uintptr_t)param;
     if (value) entered[vector] = avr->cycle;
-    else step_cycles += avr->cycle - entered[vector];
+    else if (avr->cycle - entered[vector] > step_latency) step_latency = avr->cycle - entered[vector];
 }
 
-/* Any interrupt starts (value: its vector) or the CPU is back in the main loop (0): the
- * cycles spent in interrupts, so that a main-loop part is counted without them. */
+/* The interrupt that runs changes (value: its vector; 0: back in the main loop): the time
+ * the last one ran goes to the step if it is one of the step's. */
 static void any_running(avr_irq_t *irq, uint32_t value, void *param) {
     (void)irq, (void)param;
-    static int inside;
-    if (value && !inside) inside = 1, interrupt_since = avr->cycle;
-    else if (!value && inside) inside = 0, in_interrupts += avr->cycle - interrupt_since;
+    if (step_vector[top]) step_cycles += avr->cycle - top_since;
+    top = (uint8_t)(value & 63);
+    top_since = avr->cycle;
 }
 
 /* The firmware's probe marks (probe.h). In an interrupt a busy mark enrols that interrupt
- * (timed whole from then on); in the main loop busy and idle bound its part of the step,
- * counted without the interrupts that came meanwhile (the step's latency counts them). */
+ * as part of the control step (timed from then on). */
 static void probe(avr_t *a, avr_io_addr_t addr, uint8_t v, void *param) {
     (void)param;
     a->data[addr] = v;
@@ -228,7 +228,6 @@ static void probe(avr_t *a, avr_io_addr_t addr, uint8_t v, void *param) {
         seed = k == 0 ? v : seed | (uint32_t)v << (8 * k);
         return;
     }
-    int in_interrupt = a->interrupts.running_ptr > 0;
     if (v == PROBE_RUN) {
         running = 1;
         seed_bytes = 0;
@@ -244,23 +243,14 @@ static void probe(avr_t *a, avr_io_addr_t addr, uint8_t v, void *param) {
         running = 0;
         trace_event("end", "");
         if (plant) printf("end\n"), fflush(stdout);
-    } else if (v == PROBE_BUSY && in_interrupt) {
+    } else if (v == PROBE_BUSY && a->interrupts.running_ptr) {
         avr_int_vector_t *vector = a->interrupts.running[a->interrupts.running_ptr - 1];
-        isr_mark = a->cycle;
         if (!step_vector[vector->vector]) {
             step_vector[vector->vector] = 1;
             entered[vector->vector] = a->cycle;
             avr_irq_register_notify(vector->irq + AVR_INT_IRQ_RUNNING, vector_running,
                                     (void *)(uintptr_t)vector->vector);
         }
-    } else if (v == PROBE_BUSY) {
-        main_since = a->cycle;
-        main_from = isr_mark;
-        main_interrupts = in_interrupts;
-    } else if (v == PROBE_IDLE && !in_interrupt && main_since) {
-        step_cycles += a->cycle - main_since - (in_interrupts - main_interrupts);
-        if (a->cycle - main_from > step_latency) step_latency = a->cycle - main_from;
-        main_since = 0;
     }
 }
 
@@ -283,7 +273,6 @@ static void board_reset(avr_t *a) {
     if (running && plant) printf("end\n"), fflush(stdout);
     running = 0;
     hung = 0;
-    main_since = 0;
     encoder_target = encoder_count;
     to_sensor.tail = to_sensor.head;
     line_reset();

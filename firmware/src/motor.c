@@ -3,10 +3,11 @@
  * loops/motor_current.py), in float32.
  *
  * Each millisecond Timer1 starts a conversion of the ACS712 on A1; its completion interrupt
- * only takes the code and the encoder's count and flags them. The main loop's control step
- * then takes the moving average (4.17), the PI + feed-forward (4.13)-(4.14) and writes the
- * duty (4.15)-(4.16) to Timer3's 8-bit PWM on D5 (ENA) with the H-bridge's direction on
- * D24/D25; the speed loop (4.12) on the encoder's counts (D2/D3, both edges of both
+ * takes the code and the encoder's count with interrupts off, then runs the control step
+ * with interrupts on (the UART is served meanwhile, and the step's timing does not depend
+ * on what the main loop is doing): the moving average (4.17), the PI + feed-forward
+ * (4.13)-(4.14) and the duty (4.15)-(4.16) to Timer3's 8-bit PWM on D5 (ENA) with the
+ * H-bridge's direction on D24/D25; the speed loop (4.12) on the encoder's counts (D2/D3, both edges of both
  * channels) drives D6 (ENB, Timer4) and D26/D27. Safe state: both enables off the PWM and
  * low, IN1-IN4 low (both bridges off). Pins: README's wiring table. */
 #include <avr/interrupt.h>
@@ -63,11 +64,10 @@ static float speed_scale[ENCODER_WINDOW + 1]; /* rad/s per count over 1-50 perio
  * rotation's is about twice that). With y = 0 and x = amplitude · cos(θ/2) at the start, y is
  * exactly amplitude · sin(θ n). */
 static float ref_x, ref_y, ref_e;
-/* The interrupts' sample: the ADC code and the encoder's count, flagged (sampled); a sample
- * that came while the last was not taken yet (missed) ends the run. */
-static volatile uint16_t sample_code;
-static volatile int32_t sample_count;
-static volatile uint8_t sampled, missed;
+/* The run's outputs may be driven (live: safe() ends it); a control step is under way
+ * (in_step); a conversion ended while one was (missed: the run ends). */
+static volatile uint8_t live, in_step, missed;
+static void safe(void);
 static const float amps_per_code = ADC_VREF / 1024.0f / SENSITIVITY;
 static const float amps_at_zero = (0.5f * ADC_VREF / 1024.0f - ZERO_VOLTAGE) / SENSITIVITY;
 static uint16_t codes[MAX_ORDER];
@@ -126,29 +126,10 @@ ISR(TIMER1_COMPA_vect) {
     probe_idle();
 }
 
-/* The conversion is done: the sample, flagged for the main loop's control step. */
-ISR(ADC_vect) {
-    probe_busy();
-    if (sampled) missed = 1;
-    sample_code = ADC;
-    sample_count = encoder;
-    sampled = 1;
-    rig_event = 1;
-    probe_idle();
-}
-
-/* The control step of the sample the interrupt flagged, in the main loop (interrupts on). */
-static const char *control(void) {
-    uint16_t code;
-    int32_t count;
-    uint8_t have, late;
-    ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-        have = sampled, late = missed, code = sample_code, count = sample_count;
-        sampled = 0;
-    }
-    if (!have) return 0;
-    if (late) return "a control step missed its 1 ms period";
-    probe_busy();
+/* The control step (4.12)-(4.17) for the sample `code`, `count`, with interrupts on; its
+ * outputs written at once, with interrupts off, and only while the run is live (safe()
+ * ends that: a step that was under way when the outputs went safe does not drive them). */
+static void step(uint16_t code, int32_t count) {
     /* (4.17) as a mean over `order` samples, those before the run counting as 0 A: the sum
      * of the codes, turned into amperes once (the ADC's reading is affine in its code). */
     code_sum = code_sum - codes[code_slot] + code; /* in 32 bits: int is 16 on the AVR */
@@ -169,12 +150,16 @@ static const char *control(void) {
     float error = i_ref - i_fb; /* (4.14) with e_I = i_ss - i (docs/deviations.md) */
     integral += ki_dt_c * error; /* the feed-forward (4.13) plus ki·∫e dt */
     int16_t duty1 = duty(kp_c * error + integral);
-    drive(&OCR3AL, PA2, duty1);
     /* (4.12) on the load motor, wired with reversed polarity: a positive V2 brakes. */
     float error_speed = speed - omega_meas;
     integral_speed += ki_speed_dt_c * error_speed;
     int16_t duty2 = duty(-(kp_speed_c * error_speed + integral_speed));
-    drive(&OCR4AL, PA4, duty2);
+    ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+        if (live) {
+            drive(&OCR3AL, PA2, duty1);
+            drive(&OCR4AL, PA4, duty2);
+        }
+    }
 
     /* Raw where a conversion can wait for the telemetry (format_sample): the ADC code and
      * the duties as integers in their channels' slots. */
@@ -184,10 +169,33 @@ static const char *control(void) {
     put_raw(values + 5, duty1);
     put_raw(values + 6, duty2);
     rig_sample();
-    if (++n >= steps) rig_done();
-    probe_idle();
-    return 0;
+    if (++n >= steps) {
+        ATOMIC_BLOCK(ATOMIC_RESTORESTATE) { safe(); } /* the last step: outputs off now */
+        rig_done();
+    }
 }
+
+/* The conversion is done: the sample taken with interrupts off, then the control step with
+ * them on (the UART's receive interrupt comes within a byte). A conversion that ends while
+ * a step is still under way (it overran its period) is not a sample: the run ends. */
+ISR(ADC_vect) {
+    probe_busy();
+    if (in_step) {
+        missed = 1;
+        return;
+    }
+    uint16_t code = ADC;
+    int32_t count = encoder;
+    in_step = 1;
+    sei();
+    step(code, count);
+    cli();
+    in_step = 0;
+    probe_idle();
+}
+
+/* The main loop's check of the run: a step that overran its period ends it. */
+static const char *control(void) { return missed ? "a control step missed its 1 ms period" : 0; }
 
 /* Off the control step: a sample's ADC code in amperes and its duties in counts and volts. */
 static void format_sample(float *values) {
@@ -258,7 +266,8 @@ static uint8_t start(float duration, const char **why) {
     code_slot = count_slot = 0;
     ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
         encoder = 0;
-        sampled = missed = 0;
+        missed = in_step = 0;
+        live = 1;
         TCCR3A |= _BV(COM3A1); /* the enables back on their PWM, at duty 0 */
         TCCR4A |= _BV(COM4A1);
         ADCSRA |= _BV(ADIF) | _BV(ADIE); /* a conversion that ended at rest is not a sample */
@@ -274,7 +283,7 @@ static uint8_t start(float duration, const char **why) {
 static void safe(void) {
     TIMSK1 = 0;
     ADCSRA = (uint8_t)((ADCSRA & ~_BV(ADIE)) | _BV(ADIF)); /* ADIF: cleared by a 1 */
-    sampled = 0;
+    live = 0;
     TCCR3A &= (uint8_t)~_BV(COM3A1);
     TCCR4A &= (uint8_t)~_BV(COM4A1);
     OCR3AL = 0;

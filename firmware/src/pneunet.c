@@ -4,8 +4,8 @@
  *
  * Timer1 runs the valve's PWM on D11 (OC1A): 8333 ticks of 4 µs, 33.332 ms (the book's
  * 1/30 s to 0.01 %). At each period's start its overflow interrupt starts a conversion of
- * the flex sensor's divider on A0; the conversion's interrupt only takes the code and flags
- * it. The main loop's control step evaluates the PID (2.2)-(2.4) with gains scheduled on the
+ * the flex sensor's divider on A0; the conversion's interrupt takes the code with interrupts
+ * off, then evaluates, with interrupts on, the PID (2.2)-(2.4) with gains scheduled on the
  * reference (constant, piecewise or fuzzy), anti-windup at the 0-255 range, and writes the
  * period's duty. The pump on D8 runs during a run. Safe state: the valve's pin off the PWM
  * and low (closed), the pump off. */
@@ -48,18 +48,18 @@ static float open_loop = -1.0f;
 /* The run. */
 static uint32_t n, steps;
 static float integral, last_error;
-/* The interrupt's sample: the ADC code, flagged (sampled); one that came while the last was
- * not taken yet (missed) ends the run. */
-static volatile uint16_t sample_code;
-static volatile uint8_t sampled, missed;
+/* The run's outputs may be driven (live: safe() ends it); a step is under way (in_step); a
+ * conversion ended while one was (missed: the run ends). */
+static volatile uint8_t live, in_step, missed;
+static void safe(void);
 
 /* The reference at step n (programs.py's Program.at). */
-static float reference_at(uint32_t step) {
+static float reference_at(uint32_t k) {
     if (shape == CONSTANT) return values[0];
     if (shape == SINUSOID) /* offset - amplitude cos(2π f t): from rest */
-        return values[0] - values[1] * cosf(2.0f * (float)M_PI * values[2] * (float)step * DT);
+        return values[0] - values[1] * cosf(2.0f * (float)M_PI * values[2] * (float)k * DT);
     /* steps: level floor(t / hold), the last held to the end; in periods, t = n / 30 s */
-    float index = floorf((float)step / (values[0] * RATE_HZ) + 1e-6f);
+    float index = floorf((float)k / (values[0] * RATE_HZ) + 1e-6f);
     return values[1 + (index < levels - 1 ? (uint8_t)index : levels - 1)];
 }
 
@@ -84,27 +84,10 @@ ISR(TIMER1_OVF_vect) {
     probe_idle();
 }
 
-/* The conversion is done: the sample, flagged for the main loop's control step. */
-ISR(ADC_vect) {
-    probe_busy();
-    if (sampled) missed = 1;
-    sample_code = ADC;
-    sampled = 1;
-    rig_event = 1;
-    probe_idle();
-}
-
-/* The control step of the sample the interrupt flagged, in the main loop (interrupts on). */
-static const char *control(void) {
-    uint16_t code;
-    uint8_t have, late;
-    ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-        have = sampled, late = missed, code = sample_code;
-        sampled = 0;
-    }
-    if (!have) return 0;
-    if (late) return "a control step missed its 33 ms period";
-    probe_busy();
+/* The PID step (2.2)-(2.4) for the sample `code`, with interrupts on; its duty written with
+ * interrupts off, and only while the run is live (safe() ends that: a step under way when
+ * the outputs went safe does not open the valve again). */
+static void step(uint16_t code) {
     const float deg_per_code = ADC_VREF / 1024.0f / SENSOR_GAIN * DEG_PER_RAD;
     const float deg_at_zero = (0.5f * ADC_VREF / 1024.0f - SENSOR_ZERO) / SENSOR_GAIN * DEG_PER_RAD;
     float angle = (float)code * deg_per_code + deg_at_zero; /* mid-step reconstruction */
@@ -131,14 +114,38 @@ static const char *control(void) {
     }
     uint8_t count = u >= 255.0f ? 255 : (u <= 0.0f ? 0 : (uint8_t)u); /* floor in [0, 255] */
     uint16_t ticks = (uint16_t)(((uint32_t)count * TICKS + 127) / 255); /* the period's duty */
-    ATOMIC_BLOCK(ATOMIC_RESTORESTATE) { OCR1A = ticks; } /* 16 bits through TEMP: whole */
+    ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+        if (live) OCR1A = ticks; /* the period's duty, only while the run is live */
+    }
     float *sample = rig_slot();
     sample[0] = reference, sample[1] = angle, sample[2] = count;
     rig_sample();
-    if (++n >= steps) rig_done();
-    probe_idle();
-    return 0;
+    if (++n >= steps) {
+        ATOMIC_BLOCK(ATOMIC_RESTORESTATE) { safe(); } /* the last step: valve and pump off */
+        rig_done();
+    }
 }
+
+/* The conversion is done: the sample taken with interrupts off, then the PID with them on
+ * (the UART's receive interrupt comes within a byte). A conversion that ends while a step
+ * is still under way (it overran its period) is not a sample: the run ends. */
+ISR(ADC_vect) {
+    probe_busy();
+    if (in_step) {
+        missed = 1;
+        return;
+    }
+    uint16_t code = ADC;
+    in_step = 1;
+    sei();
+    step(code);
+    cli();
+    in_step = 0;
+    probe_idle();
+}
+
+/* The main loop's check of the run: a step that overran its period ends it. */
+static const char *control(void) { return missed ? "a control step missed its 33 ms period" : 0; }
 
 static uint8_t configure(uint8_t kind, const uint8_t *body, uint8_t length, const char **why) {
     if (kind == SET_GAINS) {
@@ -201,7 +208,8 @@ static uint8_t start(float duration, const char **why) {
     n = 0;
     integral = last_error = 0.0f;
     ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-        sampled = missed = 0;
+        missed = in_step = 0;
+        live = 1;
         OCR1A = 0;
         TCCR1A |= _BV(COM1A1); /* the valve back on its PWM, at duty 0 */
         PORTH |= _BV(PH5);     /* the pump */
@@ -219,7 +227,7 @@ static uint8_t start(float duration, const char **why) {
 static void safe(void) {
     TIMSK1 = 0;
     ADCSRA = (uint8_t)((ADCSRA & ~_BV(ADIE)) | _BV(ADIF)); /* ADIF: cleared by a 1 */
-    sampled = 0;
+    live = 0;
     TCCR1A &= (uint8_t)~_BV(COM1A1);
     OCR1A = 0;
     PORTB &= (uint8_t)~_BV(PB5);

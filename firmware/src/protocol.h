@@ -34,6 +34,8 @@ uint8_t frame_receive(uint8_t byte, struct command *out);
 /* ERROR naming a command: its seq, a code and a text (up to MAX_FRAME - 8 characters, what a
  * frame holds; tests/firmware checks every text of firmware/src fits). */
 void send_error(uint16_t seq, uint8_t code, const char *text);
+/* A reply's body as it is built (INFO, ERROR, a GET's ACK): one buffer for all of them. */
+extern uint8_t reply_body[MAX_FRAME - 5];
 /* ACK naming a command. */
 void send_ack(uint16_t seq);
 /* The little-endian u32 `value` into out[0..3]. */

@@ -15,6 +15,7 @@
 #define HOST_TIMEOUT_MS 500    /* START's default host_timeout_ms */
 #define MIN_HOST_TIMEOUT_MS 20 /* START's range for it */
 #define MAX_HOST_TIMEOUT_MS 60000
+#define REPLY_ROOM (MAX_FRAME + 2) /* the send queue's room for any reply: a frame, stuffed */
 enum reset_cause { POWER_ON = 0, EXTERNAL = 1, WATCHDOG = 2, BROWN_OUT = 3 };
 enum run_end { NOT_ENDED = 0, ENDED_DONE = 1, ENDED_STOP = 2, ENDED_HOST = 3, ENDED_ERROR = 4 };
 
@@ -40,13 +41,14 @@ struct sample {
     float values[MAX_CHANNELS];
 };
 static struct sample ring[RING];
-static uint8_t ring_head, ring_tail;
-static uint32_t samples; /* of the run going on, or of the last one */
+static volatile uint8_t ring_head, ring_tail; /* head: the control step's; tail: the main loop's */
+static volatile uint32_t samples;            /* of the run going on, or of the last one */
 
 /* The run: its control on (running); over, its last samples and DONE to send (draining);
  * why the last one ended; its START's seq; the last START carried out (a START sent again
  * is only acknowledged); the decimation; the host's last valid frame and its timeout. */
-static uint8_t running, draining, finished, ended;
+static uint8_t running, draining, ended;
+static volatile uint8_t finished; /* the control step's word that the run is over */
 static uint16_t run_seq, last_start;
 static uint8_t have_last_start;
 static uint16_t decimation = 1;
@@ -117,7 +119,7 @@ static uint8_t reset_cause(void) {
 }
 
 static void send_info(void) {
-    static uint8_t body[MAX_FRAME - 5];
+    uint8_t *body = reply_body;
     uint8_t n = 0;
     body[n++] = PROTOCOL_VERSION;
     body[n++] = rig->kind;
@@ -200,7 +202,9 @@ static void start(const struct command *c) {
 
 static void status(uint16_t seq) {
     uint8_t body[10] = {(uint8_t)(seq & 0xFF), (uint8_t)(seq >> 8), running || draining};
-    put_u32(body + 3, samples);
+    uint32_t taken;
+    ATOMIC_BLOCK(ATOMIC_RESTORESTATE) { taken = samples; }
+    put_u32(body + 3, taken);
     uint16_t lost = uart_overruns();
     body[7] = (uint8_t)(lost & 0xFF);
     body[8] = (uint8_t)(lost >> 8);
@@ -209,7 +213,7 @@ static void status(uint16_t seq) {
 }
 
 static void get(const struct command *c) {
-    static uint8_t body[MAX_FRAME - 5];
+    uint8_t *body = reply_body;
     if (c->length != 1) {
         send_error(c->seq, BAD_FRAME, "GET takes the type of a SET_ command (u8)");
         return;
@@ -272,8 +276,10 @@ static uint8_t send_sample(void) {
     if (ring_tail == ring_head) return 0;
     const struct sample *s = &ring[ring_tail];
     uint8_t length = (uint8_t)(4 + 4 * rig->channel_count);
-    if (decimation && s->index % decimation == 0) {
-        if (uart_space() < length + 8) return 0; /* type, seq, CRC, COBS, delimiter */
+    /* (A 32-bit remainder costs some 600 cycles: not for the default, every sample.) */
+    if (decimation == 1 || (decimation && s->index % decimation == 0)) {
+        /* Type, seq, CRC, COBS and delimiter besides; and the room a reply needs kept. */
+        if (uart_space() < (uint16_t)(length + 7 + REPLY_ROOM)) return 0;
         static uint8_t body[4 + 4 * MAX_CHANNELS];
         float values[MAX_CHANNELS];
         memcpy(values, s->values, sizeof(float) * rig->channel_count);
@@ -318,29 +324,35 @@ void rig_serve(const struct rig *program) {
     send_info();
     set_sleep_mode(SLEEP_MODE_IDLE);
     struct command command;
-    uint8_t byte;
+    uint8_t bytes[6]; /* a batch: shorter than any frame (7 bytes), so one ends in it at most */
     for (;;) {
         wdt_reset();
         run_checks();
-        if (uart_read(&byte)) { /* a byte at a time: the control step comes between bytes */
-            if (frame_receive(byte, &command)) {
+        /* The bytes that came, until a sample is flagged (the control step goes first), and
+         * only with room for a reply: the main loop never waits on the line during a run. */
+        uint8_t took = 0;
+        if (uart_space() >= REPLY_ROOM) took = uart_take(bytes, sizeof bytes);
+        for (uint8_t k = 0; k < took; k++) {
+            if (frame_receive(bytes[k], &command)) {
                 heard_ms = rig_clock_ms();
-                handle(&command);
+                handle(&command); /* its reply fits: the room was there */
             }
-            continue;
         }
+        if (took) continue;
         if (send_sample()) continue;
         if (draining && ring_tail == ring_head) {
             uint8_t body[6] = {(uint8_t)(run_seq & 0xFF), (uint8_t)(run_seq >> 8)};
-            put_u32(body + 2, samples);
+            put_u32(body + 2, samples); /* the run is over: no interrupt changes it */
             draining = 0;
             frame_send(DONE, body, 6);
         }
         /* Nothing to do: sleep until an interrupt (a byte, a sample, the clock's tick). A
          * sample that waits for room on the line does not keep the loop awake: the send
-         * queue's interrupt wakes it as room comes. */
+         * queue's interrupt wakes it as room comes. Checked with interrupts off: what an
+         * interrupt leaves after this cannot be slept over. */
         cli();
-        if (!uart_pending() && !rig_event && !stalled) {
+        if (!uart_pending() && !rig_event && !stalled && !finished &&
+            (ring_tail == ring_head || uart_space() < REPLY_ROOM + 4 + 4 * MAX_CHANNELS + 7)) {
             sleep_enable();
             sei();
             sleep_cpu();

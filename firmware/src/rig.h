@@ -2,10 +2,13 @@
  * STOP, STREAM, STATUS, GET and the rig's own settings), the run's life and its one safe
  * state, the watchdog, the host timeout and a millisecond clock.
  *
- * Interrupts only sample and flag (rig_event); the rig's control step runs in the main loop
- * with interrupts on, so the UART's receive interrupt is never held off for long. Every end
- * of a run (DONE, STOP, an error, the host's silence, the watchdog, a reset) puts the
- * outputs in the rig's safe state through one function, with interrupts off. */
+ * Interrupts sample with interrupts off, for a few dozen cycles; a rig's control step then
+ * runs with interrupts on (in its sample's interrupt, re-enabled, or in the main loop), so
+ * the UART's receive interrupt is never held off for more than a fraction of a byte's time,
+ * and the step's timing does not depend on what the main loop is doing. Outputs are written
+ * with interrupts off and only while the run is live. Every end of a run (DONE, STOP, an
+ * error, the host's silence, the watchdog, a reset) puts the outputs in the rig's safe state
+ * through one function, with interrupts off. */
 #ifndef ARTICULA_RIG_H
 #define ARTICULA_RIG_H
 
@@ -37,9 +40,9 @@ struct rig {
      * interrupts disarmed, their pending flags cleared. Called with interrupts off, at
      * start-up and at every end of a run. */
     void (*safe)(void);
-    /* The run's main-loop work, called over and over while it goes on: the control step of
-     * a sample the interrupts flagged (rig_sample, rig_done), and work for coming steps;
-     * NULL, or a reason that ends the run in the safe state (an ERROR names it). */
+    /* The run's main-loop work, called over and over while it goes on: work the interrupts
+     * flagged (rig_event), and the run's own checks; NULL, or a reason that ends the run in
+     * the safe state (an ERROR names it). */
     const char *(*control)(void);
     /* Optional: a sample's values made ready to send, off the control step (e.g. raw
      * counts into units); NULL sends them as the control step gave them. */
@@ -53,13 +56,13 @@ extern volatile uint8_t rig_event;
 /* Announce the rig (INFO, unasked, with why it started), then answer commands and run;
  * never returns. */
 void rig_serve(const struct rig *rig);
-/* From control(): where the run's next sample goes (channel_count values), written in
+/* From the control step (an interrupt's or control()): where the run's next sample goes (channel_count values), written in
  * place; rig_sample() then takes it. When the telemetry is behind and its ring full, the
  * slot is a scratch one and the sample is not sent (the host sees the gap). */
 float *rig_slot(void);
-/* From control(): the sample in rig_slot() is the run's next. */
+/* From the control step: the sample in rig_slot() is the run's next. */
 void rig_sample(void);
-/* From control(): the run is over (after its last sample). */
+/* From the control step: the run is over (after its last sample, outputs safe). */
 void rig_done(void);
 /* Milliseconds since start-up, wrapping at 65536 (Timer0's 1 kHz tick). */
 uint16_t rig_clock_ms(void);

@@ -101,11 +101,13 @@ def test_damaged_and_overlong_frames_are_dropped_and_the_next_one_answered(simav
 
 
 def error_text_cap() -> int:
-    """The longest ERROR text send_error (firmware/src/protocol.c) sends whole: its body's
-    size, with protocol.h's constants, less the seq and the code."""
+    """The longest ERROR text send_error (firmware/src/protocol.c) sends whole: the size of
+    the body it builds (reply_body), with protocol.h's constants, less the seq and the code."""
     defines = dict(re.findall(r"#define (\w+) (\d+)", (SOURCES / "protocol.h").read_text()))
-    function = (SOURCES / "protocol.c").read_text().split("void send_error(", 1)[1]
-    size = re.search(r"uint8_t body\[([^]]+)\]", function.split("\n}", 1)[0]).group(1)
+    code = (SOURCES / "protocol.c").read_text()
+    function = code.split("void send_error(", 1)[1].split("\n}", 1)[0]
+    assert "reply_body" in function and "sizeof reply_body" in function
+    size = re.search(r"^uint8_t reply_body\[([^]]+)\];", code, re.M).group(1)
     size = re.sub(r"[A-Z_]+", lambda name: defines[name.group(0)], size)
     assert re.fullmatch(r"[\d\s()+*/-]+", size), size
     return eval(size) - 3  # a seq (u16) and a code (u8) come first
