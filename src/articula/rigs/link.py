@@ -51,6 +51,10 @@ class DeviceResetError(DeviceError):
     """The device restarted (power, watchdog, USB reset) while the host was using it."""
 
 
+class NoAnswerError(DeviceError):
+    """A command got neither its answer nor an ERROR after every resend."""
+
+
 @dataclass
 class LinkStats:
     """What the line lost: damaged frames, device frames missing from the sequence, commands
@@ -137,9 +141,9 @@ class Link:
         Returns:
             The device's handshake.
         """
-        try:
+        try:  # silence is bad input (a port without a rig); a device out of protocol is not
             info = protocol.decode_info(self._exchange(Kind.HELLO, b"", answer=Kind.INFO).body)
-        except DeviceError as exc:
+        except NoAnswerError as exc:
             raise PortError(str(exc)) from None
         if info.protocol != PROTOCOL_VERSION:
             raise PortError(f"{self.port}: the device speaks protocol {info.protocol}, "
@@ -247,8 +251,8 @@ class Link:
                     return self._answered()
         finally:
             self._waiting = None
-        raise DeviceError(f"{self.port}: no answer to {kind.name} after {self.retries + 1} "
-                          f"tries; is the rig on and running articula's firmware?")  # fmt: skip
+        raise NoAnswerError(f"{self.port}: no answer to {kind.name} after {self.retries + 1} "
+                            f"tries; is the rig on and running articula's firmware?")  # fmt: skip
 
     def _answered(self) -> Frame:
         """The awaited answer; an ERROR naming the command raises DeviceError."""
