@@ -196,12 +196,14 @@ def table(m: dict[str, Any]) -> tuple[str, list[str], list[list[str]]]:
         ["  ACK to outputs off, worst [ms]", f"{m['stop_ack_to_safe_ms_max']:.3f}", ""],
         ["silent hosts", f"{m['host_loss_trials']}", ">= 20"],
         ["  last frame to outputs off, worst [ms]", f"{m['host_loss_latency_ms_max']:.2f}", ""],
-        ["  beyond host_timeout_ms, worst [ms]", f"{m['host_loss_over_timeout_ms_max']:.2f}",
-         "<= 1 period"],
+        [
+            "  beyond host_timeout_ms, worst [ms]",
+            f"{m['host_loss_over_timeout_ms_max']:.2f}",
+            "<= 1 period",
+        ],
         ["bytes lost at 1 Mbaud, bursts mid-run", f"{m['rx_overruns']}", "0"],
         ["hung main loop: watchdog reset reported", f"{m['watchdog_reset_ok']}", "True"],
-        ["  hang to outputs off, worst [ms]", f"{m['watchdog_outputs_off_ms_max']:.2f}",
-         "<= 32.8"],
+        ["  hang to outputs off, worst [ms]", f"{m['watchdog_outputs_off_ms_max']:.2f}", "<= 32.8"],
     ]
     for name in PROGRAMS:
         rows.append([f"{name}: flash [bytes]", f"{m['flash_bytes'][name]}", "<= 262144"])

@@ -98,8 +98,8 @@ class Hostile:
         for pair in CHANNELS:
             for text in pair:
                 body += bytes([len(text)]) + text.encode()
-        if self.mode == "long-info":  # a unit of 200 characters: 300 bytes in all
-            body = body[:-3] + bytes([200]) + b"x" * 200
+        if self.mode == "long-info":  # a last text of 226 characters: a frame of 300 bytes
+            body = body[:-7] + bytes([226]) + b"x" * 226
         return body + b"\0"  # reset: power-on
 
     def answer(self, kind: int, seq: int, body: bytes) -> None:

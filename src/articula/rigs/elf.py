@@ -62,7 +62,7 @@ def _named_program(data: bytes) -> str | None:
     """The program named in the ELF's .articula section; None without one (or a section
     table that does not read)."""
     try:
-        shoff, = struct.unpack_from("<I", data, 32)
+        (shoff,) = struct.unpack_from("<I", data, 32)
         entsize, count, names = struct.unpack_from("<HHH", data, 46)
         sections = [struct.unpack_from("<IIIIII", data, shoff + k * entsize)
                     for k in range(count)]  # fmt: skip

@@ -114,10 +114,12 @@ class FirmwareRig:
     ) -> None:
         elf = Path(elf)
         harness = elf.parent / "harness"
-        for what in (elf, harness):
-            if not what.is_file():
-                raise ConfigError("--firmware", f"{what} does not exist; {BUILD_HINT}")
+        if not elf.is_file():
+            raise ConfigError("--firmware", f"{elf} does not exist; {BUILD_HINT}")
         check_firmware(elf, plant.program)
+        if not harness.is_file():
+            raise ConfigError("--firmware", f"{harness} does not exist beside {elf.name}; "
+                              f"{BUILD_HINT}")  # fmt: skip
         self.plant = plant
         self.step_cycles: list[int] = []  # per control period of the last run
         self.step_latency: list[int] = []

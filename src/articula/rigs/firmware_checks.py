@@ -65,7 +65,14 @@ class HostLossTrial:
 
 
 def period_cycles(link: Link) -> int:
-    """The rig's control period in CPU cycles."""
+    """The rig's control period in CPU cycles.
+
+    Args:
+        link: the line to the rig (its handshake's sample period).
+
+    Returns:
+        The period [CPU cycles at 16 MHz].
+    """
     return round(link.info.sample_period_us * CPU_HZ / 1_000_000)
 
 
@@ -88,7 +95,9 @@ def _trace_past(trace: PinTrace, link: Link, cycle: int) -> None:
         link.status()
 
 
-def stop_trial(rig: FirmwareRig, trace: PinTrace, link: Link, rng: np.random.Generator) -> StopTrial:
+def stop_trial(
+    rig: FirmwareRig, trace: PinTrace, link: Link, rng: np.random.Generator
+) -> StopTrial:
     """START a long run, STOP it after a random number of its samples, and read the pins.
 
     Args:

@@ -309,11 +309,12 @@ class Link:
             return False  # a late answer to a HELLO sent again
         if last is not None:
             self.stats.dropped += (frame.seq - last - 1) & 0xFFFF
-        if frame.kind in (Kind.ACK, Kind.ERROR) and waiting is not None:
-            if waiting[1] == Kind.ACK or frame.kind == Kind.ERROR:
-                if _acked(frame) == waiting[0]:
-                    self._answer = frame
-                    return True
+        answers = waiting is not None and (
+            (frame.kind == Kind.ACK and waiting[1] == Kind.ACK) or frame.kind == Kind.ERROR
+        )
+        if answers and _acked(frame) == waiting[0]:  # its ACK, or an ERROR naming it
+            self._answer = frame
+            return True
         if frame.kind == Kind.ACK or self.info is None:
             return False  # a late answer; or, before the handshake, an earlier session's
         if len(self.inbox) >= MAX_INBOX:

@@ -13,8 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from articula.rigs import protocol
 from articula.errors import DeviceError
+from articula.rigs import protocol
 from articula.rigs.protocol import Frame
 
 CPU_HZ = 16_000_000
@@ -109,7 +109,9 @@ class PinTrace:
         self.path = Path(path)
         self.pins: list[PinState] = []
         self.frames: list[LineFrame] = []
-        self.events: list[tuple[str, int]] = []  # ("run" | "end" | "reset" | "hang" | "overrun", cycle)
+        self.events: list[
+            tuple[str, int]
+        ] = []  # ("run" | "end" | "reset" | "hang" | "overrun", cycle)
         self._offset = 0
 
     def update(self) -> PinTrace:

@@ -234,8 +234,8 @@ def decode(frame: bytes) -> Frame:
     kind, seq = HEADER.unpack_from(payload)
     if len(payload) > MAX_FRAME:
         name = Kind(kind).name if kind in Kind._value2member_map_ else f"type 0x{kind:02x}"
-        raise DeviceError(f"a {name} frame of {len(payload)} bytes, more than the protocol's "
-                          f"{MAX_FRAME}")  # fmt: skip
+        raise DeviceError(f"a frame of {len(payload)} bytes ({name}), more than the "
+                          f"protocol's {MAX_FRAME}")  # fmt: skip
     return Frame(kind, seq, payload[HEADER.size : -CRC.size])
 
 

@@ -26,7 +26,6 @@ import numpy as np
 from articula.control.pid import GainSchedule
 from articula.errors import ConfigError
 from articula.rigs.link import Link
-from articula.rigs.motor import MotorGains
 from articula.rigs.pneunet import SCHEDULES, decode_gains, encode_gains
 from articula.rigs.programs import Program, Shape
 from articula.rigs.protocol import Kind, RigKind

@@ -11,6 +11,7 @@ the host sends it a STOP on the way out of any run that did not end well.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import struct
 import time
@@ -24,7 +25,9 @@ from articula.rigs.protocol import Frame, Kind, RunEnd, unpack_floats
 
 HEARTBEAT_S = 0.04  # [s] between the host's STATUS frames during a run
 HOST_TIMEOUT_MS = 500  # the device's host timeout a run asks for (START's default)
-DEADLINE_MARGIN_S = 10.0  # [s] a run may take beyond its duration (a device's start, a slow emulator)
+DEADLINE_MARGIN_S = (
+    10.0  # [s] a run may take beyond its duration (a device's start, a slow emulator)
+)
 WRAP_US = 1 << 32  # the device time's modulus [µs] (71.6 minutes)
 
 
@@ -129,9 +132,7 @@ def run_program(
             if frame is not None:
                 ended = take(frame)
     except BaseException:
-        try:
+        with contextlib.suppress(DeviceError):  # the line is gone: the host timeout stops it
             link.notify(Kind.STOP)
-        except DeviceError:
-            pass  # the line is gone: the device's host timeout stops it
         raise
     return np.array(times), np.array(rows).reshape(-1, channels)
