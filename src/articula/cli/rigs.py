@@ -159,10 +159,10 @@ def info(port: Port, as_json: JsonFlag = False) -> None:
         emit_json(summary)
         return
     out.print(f"{summary['rig']} rig on {port}: protocol {i.protocol}, firmware "
-              f"{summary['firmware']}, a sample every {i.sample_period_us} µs, started by "
-              f"{summary['reset']}")  # fmt: skip
+              f"{summary['firmware']}, a sample every {i.sample_period_us} µs")  # fmt: skip
     for c in i.channels:
         out.print(escape(f"  {c.name} [{c.unit}]"))
+    out.print(f"last started by: {summary['reset']}")
 
 
 RIG_RUNS = {  # experiment -> (its driver, the rig it needs)

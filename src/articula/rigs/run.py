@@ -96,9 +96,9 @@ def run_program(
         if frame.kind == Kind.TELEMETRY:
             t = clock.seconds(struct.unpack_from("<I", frame.body)[0])
             if len(times) >= most or t > duration + period:
-                raise DeviceError(f"{link.port}: a sample at {t:g} s, the {len(times) + 1}th, "
-                                  f"of a {duration:g} s run with a sample every {period:g} s; "
-                                  "the device sends more than the run has")  # fmt: skip
+                raise DeviceError(f"{link.port}: sample {len(times) + 1} came at {t:g} s of a "
+                                  f"{duration:g} s run with a sample every {period:g} s; the "
+                                  "device sends more than the run has")  # fmt: skip
             times.append(t)
             rows.append(unpack_floats(frame.body, channels, 4))
             if on_sample is not None:
