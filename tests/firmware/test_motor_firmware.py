@@ -103,4 +103,4 @@ def test_emulate_motor_with_firmware_runs_a_figure_from_the_command_line(emulate
     assert record["metrics"]["current_rms_error"] is None
     assert record["metrics"]["noise_rms"] is None
     table = cli("rig", "run", path, config, "--out", tmp_path / "table").stdout
-    assert [line for line in table.splitlines() if "noise_rms" in line][0].split()[-2] == "—"
+    assert next(line for line in table.splitlines() if "noise_rms" in line).split()[-2] == "—"
