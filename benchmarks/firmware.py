@@ -16,6 +16,30 @@ Builds firmware/ (make, into DIR or a temporary folder), then:
                             ATmega2560's 8 KiB (target <= 0.5)
   firmware_run_s, simulation_run_s  wall time of Fig. 4.6 on the emulated firmware (over the
                             pty) and, the baseline, in process (simulate_batch); their ratio
+
+motor_loop_cycles_max takes every path: the five figures (constant, step and sinusoidal
+references, saturation) and a run with command bursts; a step is its two interrupts (the
+control tick, the ADC's sample) and its main-loop part, less the interrupts that came
+meanwhile. motor_step_latency_cycles_max: from the sample's interrupt to the end of its
+step, everything included (the main loop may be sending a frame when the sample comes).
+
+Safety (issue 27), on the emulated board with its pins read from the harness's trace
+(articula.rigs.firmware_checks):
+  stop_trials, stop_failures  STOPs at random phases of the control period (300 motor, 100
+                            PneuNet, 100 six-chamber), and those after which an output was
+                            active more than one period after the STOP's ACK;
+                            stop_phase_bins (of 10) the STOPs fell in, per rig;
+                            stop_ack_to_safe_ms_max (negative: off before the ACK went out)
+  host_loss_trials, host_loss_latency_ms_max  runs whose host went silent (host_timeout_ms
+                            100, 250, 500 in turn), and the longest from its last frame to
+                            every output off; host_loss_over_timeout_ms_max: that beyond
+                            each run's timeout (target: at most one period)
+  rx_overruns               bytes lost by the firmware's USART (the harness models its
+                            2-byte buffer) over runs at 1 Mbaud with command bursts mid-run,
+                            its STOP included (motor, PneuNet, six-chamber)
+  watchdog_reset_ok         on each rig a hung main loop put the outputs off within the
+                            watchdog's 32.8 ms, reset the board, and the host raised
+                            DeviceResetError naming the watchdog; watchdog_outputs_off_ms_max
 """
 
 from __future__ import annotations
@@ -33,11 +57,19 @@ from articula.book.ch4.experiment import CurrentControlConfig, simulate_batch
 from articula.book.ch4.rig import firmware_motor, run_on_rig
 from articula.book.study import packaged
 from articula.rigs.firmware import FirmwareRig
+from articula.rigs.firmware_checks import (
+    host_loss_trial,
+    stop_trial,
+    traffic_trial,
+    watchdog_trial,
+)
 from articula.rigs.link import Link
+from articula.rigs.pin_trace import PinTrace
 from articula.rigs.pneunet import PneuNetPins, PneuNetRig
 from articula.rigs.programs import steps
 from articula.rigs.protocol import RigKind
 from articula.rigs.recorder import Recorder
+from articula.rigs.six_chamber import SixChamberPins
 from articula.validation import load_toml, parse_model
 
 FIRMWARE = Path(__file__).resolve().parents[1] / "firmware"
@@ -46,6 +78,10 @@ FIGURES = ("fig4_5", "fig4_6", "fig4_7", "fig4_8", "fig4_9")
 RAM = 8192  # [bytes] the ATmega2560's SRAM
 MOTOR_PERIOD_CYCLES = 16_000
 PNEUNET_PERIOD_CYCLES = 533_312  # 8333 ticks of Timer1 at 16 MHz / 64
+STOPS = {"motor": 300, "pneunet": 100, "six_chamber": 100}
+HOST_LOSSES = {"motor": 10, "pneunet": 5, "six_chamber": 5}
+HOST_TIMEOUTS_MS = (100, 250, 500)
+BURSTS = {"motor": 100, "pneunet": 30, "six_chamber": 30}
 
 
 def measure(build: str | None) -> dict[str, Any]:
@@ -59,7 +95,7 @@ def measure(build: str | None) -> dict[str, Any]:
             m["flash_bytes"][name] = text + data
             m["ram_bytes"][name] = data + bss
             m["ram_fraction"][name] = (data + bss) / RAM
-        cycles, wall = [], {}
+        cycles, latency, wall = [], [], {}
         for figure in FIGURES:
             config = _figure(figure)
             plant = firmware_motor(config)
@@ -71,7 +107,11 @@ def measure(build: str | None) -> dict[str, Any]:
                 run_on_rig(config, link, recorder)
                 wall[figure] = time.perf_counter() - start
                 cycles += rig.step_cycles[1:]  # the first reports the cycles before the run
+                latency += rig.step_latency[1:]
+        m.update(safety(folder, cycles, latency))
         m["motor_loop_cycles_max"] = int(max(cycles))
+        m["motor_step_latency_cycles_max"] = int(max(latency))
+        m["motor_step_latency_fraction"] = m["motor_step_latency_cycles_max"] / MOTOR_PERIOD_CYCLES
         m["motor_loop_cycles_median"] = float(np.median(cycles))
         m["motor_loop_budget_fraction"] = m["motor_loop_cycles_max"] / MOTOR_PERIOD_CYCLES
         start = time.perf_counter()
@@ -83,6 +123,48 @@ def measure(build: str | None) -> dict[str, Any]:
             PneuNetRig(link, steps((30.0, 60.0), 2.0), 4.0, 0)(np.array([2.0, 1.5, 0.05]))
             m["pneunet_loop_cycles_max"] = int(max(rig.step_cycles[1:]))
         m["pneunet_loop_budget_fraction"] = m["pneunet_loop_cycles_max"] / PNEUNET_PERIOD_CYCLES
+    return m
+
+
+def safety(folder: Path, cycles: list[int], latency: list[int]) -> dict[str, Any]:
+    """The safety keys of the module's docstring; the motor's steps under command bursts
+    are added to `cycles` and `latency`."""
+    plants = {"motor": lambda: firmware_motor(CurrentControlConfig()), "pneunet": PneuNetPins,
+              "six_chamber": SixChamberPins}  # fmt: skip
+    rng = np.random.default_rng(27)
+    m: dict[str, Any] = {"stop_trials": 0, "stop_failures": 0, "stop_phase_bins": {},
+                         "stop_ack_to_safe_ms_max": -np.inf, "host_loss_trials": 0,
+                         "host_loss_latency_ms_max": 0.0, "host_loss_over_timeout_ms_max": 0.0,
+                         "rx_overruns": 0, "watchdog_reset_ok": True,
+                         "watchdog_outputs_off_ms_max": 0.0}  # fmt: skip
+    for name, make in plants.items():
+        with tempfile.TemporaryDirectory() as scratch:
+            path = Path(scratch) / "trace"
+            with FirmwareRig(folder / f"{name}.elf", make(), trace=path) as rig, \
+                    Link(rig.path) as link:  # fmt: skip
+                trace = PinTrace(path)
+                stops = [stop_trial(rig, trace, link, rng) for _ in range(STOPS[name])]
+                m["stop_trials"] += len(stops)
+                m["stop_failures"] += sum(t.failed for t in stops)
+                m["stop_phase_bins"][name] = len({int(10 * t.phase) for t in stops})
+                worst = max(t.ack_to_safe_s for t in stops) * 1e3
+                m["stop_ack_to_safe_ms_max"] = max(m["stop_ack_to_safe_ms_max"], worst)
+                for k in range(HOST_LOSSES[name]):
+                    timeout = HOST_TIMEOUTS_MS[k % len(HOST_TIMEOUTS_MS)]
+                    loss = host_loss_trial(rig, trace, link, timeout)
+                    m["host_loss_trials"] += 1
+                    ms = loss.latency_s * 1e3 if loss.said_why else np.inf
+                    m["host_loss_latency_ms_max"] = max(m["host_loss_latency_ms_max"], ms)
+                    over = max(m["host_loss_over_timeout_ms_max"], ms - timeout)
+                    m["host_loss_over_timeout_ms_max"] = over
+                m["rx_overruns"] += traffic_trial(rig, trace, link, BURSTS[name])
+                if name == "motor":
+                    cycles += rig.step_cycles[1:]
+                    latency += rig.step_latency[1:]
+                ok, off_s = watchdog_trial(rig, trace, link)
+                m["watchdog_reset_ok"] &= ok
+                m["watchdog_outputs_off_ms_max"] = max(m["watchdog_outputs_off_ms_max"],
+                                                       off_s * 1e3)  # fmt: skip
     return m
 
 
@@ -107,7 +189,21 @@ def table(m: dict[str, Any]) -> tuple[str, list[str], list[list[str]]]:
         ["motor step, worst [cycles]", f"{m['motor_loop_cycles_max']}", ""],
         ["motor step, median [cycles]", f"{m['motor_loop_cycles_median']:.0f}", ""],
         ["motor step / 1 ms period", f"{m['motor_loop_budget_fraction']:.3f}", "<= 0.25"],
+        ["motor step latency, worst [cycles]", f"{m['motor_step_latency_cycles_max']}", ""],
         ["PneuNet step / 33.3 ms period", f"{m['pneunet_loop_budget_fraction']:.4f}", ""],
+        ["STOPs at random phases", f"{m['stop_trials']}", ">= 500"],
+        ["  outputs on > 1 period after the ACK", f"{m['stop_failures']}", "0"],
+        ["  ACK to outputs off, worst [ms]", f"{m['stop_ack_to_safe_ms_max']:.3f}", ""],
+        ["silent hosts", f"{m['host_loss_trials']}", ">= 20"],
+        ["  last frame to outputs off, worst [ms]", f"{m['host_loss_latency_ms_max']:.2f}", ""],
+        [
+            "  beyond host_timeout_ms, worst [ms]",
+            f"{m['host_loss_over_timeout_ms_max']:.2f}",
+            "<= 1 period",
+        ],
+        ["bytes lost at 1 Mbaud, bursts mid-run", f"{m['rx_overruns']}", "0"],
+        ["hung main loop: watchdog reset reported", f"{m['watchdog_reset_ok']}", "True"],
+        ["  hang to outputs off, worst [ms]", f"{m['watchdog_outputs_off_ms_max']:.2f}", "<= 32.8"],
     ]
     for name in PROGRAMS:
         rows.append([f"{name}: flash [bytes]", f"{m['flash_bytes'][name]}", "<= 262144"])

@@ -1,156 +1,131 @@
 /* Runs a rig's firmware ELF on a simulated ATmega2560 at 16 MHz (simavr), UART0 behind a
  * pseudo-terminal, and couples its pins to a simulated plant in lock step.
  *
- *   harness FIRMWARE.elf [--plant] [--tick-us N] [--realtime]
+ *   harness FIRMWARE.elf [--plant] [--tick-us N] [--realtime] [--trace FILE]
  *
  * Prints "uart0 at <device path>" once the firmware's start-up (its INFO, sent unasked) has
  * gone to the pty, then runs until killed (or, with --plant, until its standard input closes:
- * the plant process has ended). The host opens that path as it would open /dev/ttyACM0.
- * SIGUSR1 resets the board, as its reset button does: the firmware starts again.
+ * the plant process has ended). The host opens that path as it would open /dev/ttyACM0;
+ * line.c receives its bytes as the chip's USART does (a two-byte buffer, data overruns).
+ * SIGUSR1 resets the board, as its reset button does (MCUSR: EXTRF); SIGUSR2 hangs the
+ * firmware's main loop (a bug's endless loop, interrupts still on): the program's own
+ * `rjmp .` of avr-libc's exit, jumped to from the main loop. The watchdog is simavr's; a
+ * watchdog reset sets WDRF, power-on PORF.
  *
  * --plant: a plant process (articula's rigs/firmware.py) on the other end of standard input
  * and output. Each ADC conversion the firmware starts is one control period: the harness
  * writes
- *     sample <adc channel> <PORTA> <PORTC> <PORTH> <OCR1A> <OCR3A> <OCR4A> <step cycles>
- * (the output registers as the firmware left them, and the CPU cycles of the previous control
- * step) and waits for "<adc code> <encoder count> [<hex bytes>]": the code the conversion
- * reads, the count the quadrature encoder on D2/D3 (PE4/PE5) reaches, one edge every
- * EDGE_CYCLES, and bytes a sensor sends on Serial1 (RX1, at 115 200 baud). With --tick-us
- * the plant has its own step instead: an exchange every N µs of a run (adc channel 255),
- * from N µs after its start. A run starting (the firmware's probe, probe.h) is
- * "run <seed>"; its end "end".
+ *     sample <adc channel> <PORTA> <PORTC> <PORTH> <OCR1A> <OCR3A> <OCR4A> <cycles> <latency>
+ * (the output registers as the firmware left them; the CPU cycles of the previous control
+ * step: the time its marked interrupts ran, the interrupts nested in them not counted; and
+ * its latency: the longest from a marked interrupt's entry to its reti, nested ones
+ * included) and waits
+ * for "<adc code> <encoder count> [<hex bytes>]": the code the conversion reads, the count
+ * the quadrature encoder on D2/D3 (PE4/PE5) reaches, one edge every EDGE_CYCLES, and bytes a
+ * sensor sends on Serial1 (RX1, at 115 200 baud). With --tick-us the plant has its own step
+ * instead: an exchange every N µs of a run (adc channel 255), from N µs after its start. A
+ * run starting (the firmware's probe, probe.h) is "run <seed>"; its end "end".
  *
- * Time: during a run the simulation runs as fast as the plant answers (--realtime: at the
- * wall clock's pace); at rest it keeps the wall clock's pace, so an idle rig costs little. */
+ * --trace FILE: a line "pins <cycle> <PORTA> <PORTB> <PORTC> <PORTE> <PORTH> <TCCR1A>
+ * <TCCR3A> <TCCR4A> <OCR1A> <OCR3A> <OCR4A>" whenever one of those registers changes (after
+ * the instruction that changed it), the host's and the firmware's frames (line.c), "run",
+ * "end", "reset", "hang": what a logic analyser on the board would see.
+ *
+ * Time: during a run the simulation runs as fast as the plant answers, while the host talks
+ * (a byte within the last HOST_QUIET_CYCLES); otherwise, and always with --realtime, it keeps
+ * the wall clock's pace, so a host's silence lasts as long for the firmware as for the host
+ * and an idle rig costs little. */
 #include <errno.h>
-#include <fcntl.h>
 #include <poll.h>
-#include <pty.h>
 #include <signal.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <termios.h>
 #include <time.h>
 #include <unistd.h>
 
 #include "avr_adc.h"
 #include "avr_ioport.h"
 #include "avr_uart.h"
-#include "sim_avr.h"
+#include "harness.h"
 #include "sim_elf.h"
 #include "sim_interrupts.h"
 #include "sim_time.h"
 
 #define GPIOR0 0x3E /* data-space addresses of the ATmega2560's registers */
 #define GPIOR1 0x4A
-#define PORTA 0x22
-#define PORTC 0x28
-#define PORTH 0x102
-#define OCR1AL 0x88
-#define OCR3AL 0x98
-#define OCR4AL 0xA8
-#define UCSR0B 0xC1
-#define RXEN0 0x10
+#define MCUSR 0x54
+#define PORF 0x01
+#define EXTRF 0x02
 #define PROBE_RUN 1 /* probe.h's marks */
-#define PROBE_STEP 2
+#define PROBE_BUSY 2
+#define PROBE_IDLE 3
 #define PROBE_END 4
-#define POLL_CYCLES 1600     /* the pty is served every 100 µs of simulated time */
-#define EDGE_CYCLES 64       /* between the encoder's edges */
-#define BYTE_CYCLES 160      /* a byte's time on the line at 1 Mbaud */
+#define EDGE_CYCLES 64          /* between the encoder's edges */
 #define SENSOR_BYTE_CYCLES 1389 /* at 115 200 baud */
 #define NO_CONVERSION 255
-#define QUEUE 65536          /* bytes each way between the pty and the UART */
-#define OUT_HIGH_WATER 4096  /* the simulation waits for the host above this */
+#define SENSOR_QUEUE 65536
 #define VCC_MV 5000
-#define START_CYCLES 320000  /* 20 ms: the firmware's start-up, before the path is printed */
+#define START_CYCLES 320000 /* 20 ms: the firmware's start-up, before the path is printed */
+#define HOST_QUIET_CYCLES (100 * CYCLES_PER_MS) /* a run goes fast while the host talks */
 
-struct queue {
-    uint8_t data[QUEUE];
-    uint32_t head, tail;
-};
+/* The registers a trace follows (data-space addresses), in its "pins" line's order. */
+static const uint16_t traced[] = {0x22, 0x25, 0x28, 0x2E, 0x102, 0x80, 0x90, 0xA0, 0x88, 0x98, 0xA8};
+#define TRACED (sizeof traced / sizeof traced[0])
+#define OCR1AL_AT 8 /* OCR1A is 16 bits: its high byte follows */
 
-static avr_t *avr;
-static int master = -1;
-static struct queue to_avr, to_host, to_sensor_rx;
-static int xon = 1;
-static int plant, realtime, running;
+avr_t *avr;
+int running;
+FILE *trace;
+static int plant, realtime;
 static uint32_t seed;
 static uint8_t seed_bytes;
-static avr_irq_t *uart_in, *sensor_in, *adc_in, *encoder_pin[2];
+static avr_irq_t *sensor_in, *adc_in, *encoder_pin[2];
 static avr_cycle_count_t tick_cycles; /* the plant's own step (--tick-us); 0: per conversion */
 static int32_t encoder_count, encoder_target;
 static uint8_t encoder_phase; /* the pins' state in the Gray sequence 00, 10, 11, 01 */
-static avr_cycle_count_t step_cycles, entered[64];
+static struct {
+    uint8_t data[SENSOR_QUEUE];
+    uint32_t head, tail;
+} to_sensor;
+/* The control step's cycles: the time its marked interrupts ran themselves (not the ones
+ * nested in them), and its latency: the longest from a marked interrupt's entry to its reti,
+ * the nested ones included. The interrupt running now (0: the main loop), since when. */
+static avr_cycle_count_t step_cycles, step_latency, entered[64], top_since;
+static uint8_t top;
 static uint8_t step_vector[64];
-static volatile sig_atomic_t reset_pressed; /* SIGUSR1: reset the board */
+static volatile sig_atomic_t reset_pressed, hang_pressed; /* SIGUSR1, SIGUSR2 */
+static avr_flashaddr_t hang_at;                            /* the firmware's `rjmp .` */
+static int hung;
+static void (*core_reset)(avr_t *);
 
-static uint32_t queue_size(const struct queue *q) { return q->head - q->tail; }
-
-static void fail(const char *what) {
-    fprintf(stderr, "harness: %s: %s\n", what, strerror(errno));
-    exit(1);
+void trace_event(const char *what, const char *text) {
+    if (!trace) return;
+    fprintf(trace, "%s %llu %s\n", what, (unsigned long long)avr->cycle, text);
+    fflush(trace);
 }
 
-/* A byte the firmware sent: queued for the host. */
-static void uart_output(avr_irq_t *irq, uint32_t value, void *param) {
-    (void)irq, (void)param;
-    to_host.data[to_host.head++ % QUEUE] = (uint8_t)value;
-}
-
-static void uart_xon(avr_irq_t *irq, uint32_t value, void *param) {
-    (void)irq, (void)value, (void)param;
-    xon = 1;
-}
-
-/* The host's next byte onto the line, one every byte time (10 bits at 1 Mbaud), as the USB
- * bridge delivers them; held while the UART is off or its receive buffer is full. */
-static avr_cycle_count_t uart_feed(avr_t *a, avr_cycle_count_t when, void *param) {
-    (void)a, (void)param;
-    if (!queue_size(&to_avr)) return 0;
-    if (xon && (avr->data[UCSR0B] & RXEN0)) avr_raise_irq(uart_in, to_avr.data[to_avr.tail++ % QUEUE]);
-    return when + BYTE_CYCLES;
-}
-
-static void uart_xoff(avr_irq_t *irq, uint32_t value, void *param) {
-    (void)irq, (void)param;
-    xon = !value;
-}
-
-/* With --plant: end when the plant process has (its end of standard input closed), as
- * reading the plant's answer does during a run. */
-static void exit_without_plant(void) {
+void exit_without_plant(void) {
     struct pollfd input = {STDIN_FILENO, 0, 0};
     if (plant && poll(&input, 1, 0) > 0 && (input.revents & (POLLHUP | POLLERR | POLLNVAL)))
         exit(0);
 }
 
-/* Move bytes between the pty and the UART; wait for the host when it lags far behind. */
-static avr_cycle_count_t serve_pty(avr_t *a, avr_cycle_count_t when, void *param) {
-    (void)a, (void)param;
-    if (!running) exit_without_plant(); /* in a run, the plant's next answer tells */
-    for (;;) {
-        if (QUEUE - queue_size(&to_avr) >= 4096) {
-            uint8_t buffer[4096];
-            ssize_t got = read(master, buffer, sizeof buffer);
-            for (ssize_t i = 0; i < got; i++) to_avr.data[to_avr.head++ % QUEUE] = buffer[i];
-        }
-        while (queue_size(&to_host)) {
-            uint32_t at = to_host.tail % QUEUE;
-            uint32_t length = queue_size(&to_host);
-            if (length > QUEUE - at) length = QUEUE - at;
-            ssize_t put = write(master, to_host.data + at, length);
-            if (put <= 0) break;
-            to_host.tail += (uint32_t)put;
-        }
-        if (queue_size(&to_host) <= OUT_HIGH_WATER) break;
-        struct pollfd waiting = {master, POLLOUT, 0};
-        poll(&waiting, 1, 100);
-        exit_without_plant();
-    }
-    if (queue_size(&to_avr) && !avr_cycle_timer_status(avr, uart_feed, NULL))
-        avr_cycle_timer_register(avr, BYTE_CYCLES, uart_feed, NULL);
-    return when + (running ? POLL_CYCLES : 10 * POLL_CYCLES);
+/* A "pins" line when a traced register changed since the last look. */
+static void trace_pins(void) {
+    static uint8_t last[TRACED + 1];
+    static int started;
+    uint8_t now[TRACED + 1];
+    for (size_t k = 0; k < TRACED; k++) now[k] = avr->data[traced[k]];
+    now[TRACED] = avr->data[traced[OCR1AL_AT] + 1];
+    if (started && !memcmp(now, last, sizeof now)) return;
+    started = 1;
+    memcpy(last, now, sizeof now);
+    char text[128];
+    int n = 0;
+    for (size_t k = 0; k < TRACED; k++)
+        n += snprintf(text + n, sizeof text - n, k ? " %u" : "%u",
+                      k == OCR1AL_AT ? now[k] | now[TRACED] << 8 : now[k]);
+    trace_event("pins", text);
 }
 
 /* One encoder edge toward the target, then the next one EDGE_CYCLES later. */
@@ -171,18 +146,18 @@ static uint16_t reg16(uint16_t low) { return (uint16_t)(avr->data[low] | (avr->d
 /* The sensor's next byte onto Serial1. */
 static avr_cycle_count_t sensor_feed(avr_t *a, avr_cycle_count_t when, void *param) {
     (void)a, (void)param;
-    if (!queue_size(&to_sensor_rx)) return 0;
-    avr_raise_irq(sensor_in, to_sensor_rx.data[to_sensor_rx.tail++ % QUEUE]);
+    if (to_sensor.head == to_sensor.tail) return 0;
+    avr_raise_irq(sensor_in, to_sensor.data[to_sensor.tail++ % SENSOR_QUEUE]);
     return when + SENSOR_BYTE_CYCLES;
 }
 
 /* One control period of the plant: the outputs the firmware left, then what it answers. */
 static void exchange(unsigned channel) {
-    printf("sample %u %u %u %u %u %u %u %llu\n", channel, avr->data[PORTA], avr->data[PORTC],
-           avr->data[PORTH], reg16(OCR1AL), reg16(OCR3AL), reg16(OCR4AL),
-           (unsigned long long)step_cycles);
+    printf("sample %u %u %u %u %u %u %u %llu %llu\n", channel, avr->data[0x22], avr->data[0x28],
+           avr->data[0x102], reg16(0x88), reg16(0x98), reg16(0xA8),
+           (unsigned long long)step_cycles, (unsigned long long)step_latency);
     fflush(stdout);
-    step_cycles = 0;
+    step_cycles = step_latency = 0;
     static char line[4096];
     unsigned code;
     long count;
@@ -202,15 +177,15 @@ static void exchange(unsigned channel) {
     if (encoder_target != encoder_count) avr_cycle_timer_register(avr, 1, encoder_edge, NULL);
     unsigned byte;
     for (char *at = line + used; sscanf(at, "%2x", &byte) == 1; at += 2)
-        to_sensor_rx.data[to_sensor_rx.head++ % QUEUE] = (uint8_t)byte;
-    if (queue_size(&to_sensor_rx) && !avr_cycle_timer_status(avr, sensor_feed, NULL))
+        to_sensor.data[to_sensor.head++ % SENSOR_QUEUE] = (uint8_t)byte;
+    if (to_sensor.head != to_sensor.tail && !avr_cycle_timer_status(avr, sensor_feed, NULL))
         avr_cycle_timer_register(avr, 1, sensor_feed, NULL);
 }
 
 /* A conversion starts: with a plant that steps per conversion, one control period. */
 static void adc_trigger(avr_irq_t *irq, uint32_t value, void *param) {
     (void)irq, (void)param;
-    if (!running || tick_cycles) return; /* at rest the last reading stands */
+    if (!running || tick_cycles || !plant) return; /* at rest the last reading stands */
     union {
         avr_adc_mux_t mux;
         uint32_t value;
@@ -231,9 +206,20 @@ static void vector_running(avr_irq_t *irq, uint32_t value, void *param) {
     (void)irq;
     uint8_t vector = (uint8_t)(uintptr_t)param;
     if (value) entered[vector] = avr->cycle;
-    else step_cycles += avr->cycle - entered[vector];
+    else if (avr->cycle - entered[vector] > step_latency) step_latency = avr->cycle - entered[vector];
 }
 
+/* The interrupt that runs changes (value: its vector; 0: back in the main loop): the time
+ * the last one ran goes to the step if it is one of the step's. */
+static void any_running(avr_irq_t *irq, uint32_t value, void *param) {
+    (void)irq, (void)param;
+    if (step_vector[top]) step_cycles += avr->cycle - top_since;
+    top = (uint8_t)(value & 63);
+    top_since = avr->cycle;
+}
+
+/* The firmware's probe marks (probe.h). In an interrupt a busy mark enrols that interrupt
+ * as part of the control step (timed from then on). */
 static void probe(avr_t *a, avr_io_addr_t addr, uint8_t v, void *param) {
     (void)param;
     a->data[addr] = v;
@@ -246,17 +232,18 @@ static void probe(avr_t *a, avr_io_addr_t addr, uint8_t v, void *param) {
         running = 1;
         seed_bytes = 0;
         encoder_count = encoder_target = 0; /* the firmware counts from 0 at a run's start */
+        trace_event("run", "");
         if (plant) printf("run %u\n", seed), fflush(stdout);
-        to_sensor_rx.tail = to_sensor_rx.head; /* the sensor's line starts afresh */
+        to_sensor.tail = to_sensor.head; /* the sensor's line starts afresh */
         if (plant && tick_cycles) {
             avr_cycle_timer_cancel(a, plant_tick, NULL);
             avr_cycle_timer_register(a, tick_cycles, plant_tick, NULL);
         }
     } else if (v == PROBE_END) {
         running = 0;
+        trace_event("end", "");
         if (plant) printf("end\n"), fflush(stdout);
-    } else if (v == PROBE_STEP && a->interrupts.running_ptr) {
-        /* From now on every activation of this interrupt counts whole (entry to reti). */
+    } else if (v == PROBE_BUSY && a->interrupts.running_ptr) {
         avr_int_vector_t *vector = a->interrupts.running[a->interrupts.running_ptr - 1];
         if (!step_vector[vector->vector]) {
             step_vector[vector->vector] = 1;
@@ -272,18 +259,44 @@ static void press_reset(int signal) {
     reset_pressed = 1;
 }
 
-/* The board's reset: the firmware starts again from its reset vector with its I/O registers
- * cleared (simavr's avr_reset); a run going on ends there. simavr drops every cycle timer,
- * the harness's own too, so the pty's is registered again. */
-static void reset_board(void) {
-    reset_pressed = 0;
-    avr_reset(avr);
+static void press_hang(int signal) {
+    (void)signal;
+    hang_pressed = 1;
+}
+
+/* Every reset of the board (the button, the watchdog): the firmware starts again from its
+ * reset vector with its I/O registers cleared (simavr's avr_reset); a run going on ends
+ * there. simavr drops every cycle timer, the harness's own too: the pty's is registered
+ * again. */
+static void board_reset(avr_t *a) {
+    if (core_reset) core_reset(a);
     if (running && plant) printf("end\n"), fflush(stdout);
     running = 0;
-    xon = 1;
+    hung = 0;
     encoder_target = encoder_count;
-    to_sensor_rx.tail = to_sensor_rx.head;
-    avr_cycle_timer_register(avr, POLL_CYCLES, serve_pty, NULL);
+    to_sensor.tail = to_sensor.head;
+    line_reset();
+    line_serve();
+    trace_event("reset", "");
+}
+
+/* SIGUSR2: once the main loop runs with interrupts on, send it to the firmware's endless
+ * loop (avr-libc's exit: cli, then rjmp to itself; the jump skips the cli). */
+static void hang_main_loop(void) {
+    if (avr->interrupts.running_ptr || !avr->sreg[S_I] || avr->state != cpu_Running) return;
+    hang_pressed = 0;
+    hung = 1;
+    avr->pc = hang_at;
+    trace_event("hang", "");
+}
+
+/* The firmware's `rjmp .` after avr-libc's `cli` in exit (F8 94 FF CF); 0 if none. */
+static avr_flashaddr_t endless_loop(void) {
+    for (avr_flashaddr_t at = 0; at + 4 <= avr->flashend; at += 2)
+        if (avr->flash[at] == 0xF8 && avr->flash[at + 1] == 0x94 && avr->flash[at + 2] == 0xFF &&
+            avr->flash[at + 3] == 0xCF)
+            return at + 2;
+    return 0;
 }
 
 static uint64_t wall_ns(void) {
@@ -292,14 +305,14 @@ static uint64_t wall_ns(void) {
     return (uint64_t)now.tv_sec * 1000000000u + (uint64_t)now.tv_nsec;
 }
 
-/* Sleeping firmware: keep the wall clock's pace at rest (or always with --realtime), counted
- * from when pacing began (simavr's own pacing counts from the start, and after a fast run it
- * would stop the clock until the wall caught up). */
+/* Sleeping firmware: keep the wall clock's pace at rest, while the host is quiet in a run
+ * (or always with --realtime), counted from when pacing began (simavr's own pacing counts
+ * from the start, and after a fast run it would stop the clock until the wall caught up). */
 static void sleep_callback(avr_t *a, avr_cycle_count_t how_long) {
     static int paced;
     static uint64_t anchor_ns;
     static avr_cycle_count_t anchor_cycle;
-    if (!realtime && running) {
+    if (!realtime && running && a->cycle - line_heard() < HOST_QUIET_CYCLES) {
         paced = 0;
         return;
     }
@@ -316,15 +329,22 @@ static void sleep_callback(avr_t *a, avr_cycle_count_t how_long) {
 
 int main(int argc, char **argv) {
     static elf_firmware_t firmware; /* zeroed */
+    const char *trace_path = NULL;
     for (int i = 2; i < argc; i++) {
         if (!strcmp(argv[i], "--plant")) plant = 1;
         else if (!strcmp(argv[i], "--realtime")) realtime = 1;
         else if (!strcmp(argv[i], "--tick-us") && i + 1 < argc)
             tick_cycles = 16u * (avr_cycle_count_t)strtoul(argv[++i], NULL, 10);
+        else if (!strcmp(argv[i], "--trace") && i + 1 < argc) trace_path = argv[++i];
         else argc = 0;
     }
     if (argc < 2 || elf_read_firmware(argv[1], &firmware) != 0) {
-        fprintf(stderr, "usage: harness FIRMWARE.elf [--plant] [--tick-us N] [--realtime]\n");
+        fprintf(stderr, "usage: harness FIRMWARE.elf [--plant] [--tick-us N] [--realtime] "
+                        "[--trace FILE]\n");
+        return 2;
+    }
+    if (trace_path && !(trace = fopen(trace_path, "w"))) {
+        fprintf(stderr, "harness: %s: %s\n", trace_path, strerror(errno));
         return 2;
     }
     avr = avr_make_mcu_by_name("atmega2560");
@@ -334,50 +354,48 @@ int main(int argc, char **argv) {
     avr->vcc = avr->avcc = avr->aref = VCC_MV;
     avr_load_firmware(avr, &firmware);
     avr->sleep = sleep_callback;
+    avr->data[MCUSR] = PORF; /* powered on */
+    core_reset = avr->reset;
+    avr->reset = board_reset;
+    hang_at = endless_loop();
 
     uint32_t flags = 0; /* no stdio echo, no sleeping while the firmware polls the UART */
     avr_ioctl(avr, AVR_IOCTL_UART_GET_FLAGS('0'), &flags);
     flags &= ~(uint32_t)(AVR_UART_FLAG_STDIO | AVR_UART_FLAG_POLL_SLEEP);
     avr_ioctl(avr, AVR_IOCTL_UART_SET_FLAGS('0'), &flags);
-    uart_in = avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_INPUT);
-    avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUTPUT),
-                            uart_output, NULL);
-    avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XON),
-                            uart_xon, NULL);
-    avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('0'), UART_IRQ_OUT_XOFF),
-                            uart_xoff, NULL);
     avr_register_io_write(avr, GPIOR0, probe, NULL);
     avr_register_io_write(avr, GPIOR1, probe, NULL);
+    avr_irq_register_notify(avr->interrupts.irq + AVR_INT_IRQ_RUNNING, any_running, NULL);
     adc_in = avr_io_getirq(avr, AVR_IOCTL_ADC_GETIRQ, ADC_IRQ_ADC0);
+    avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_ADC_GETIRQ, ADC_IRQ_OUT_TRIGGER),
+                            adc_trigger, NULL);
     if (plant) {
-        avr_irq_register_notify(avr_io_getirq(avr, AVR_IOCTL_ADC_GETIRQ, ADC_IRQ_OUT_TRIGGER),
-                                adc_trigger, NULL);
         for (int k = 0; k < 2; k++)
             encoder_pin[k] = avr_io_getirq(avr, AVR_IOCTL_IOPORT_GETIRQ('E'), 4 + k);
         sensor_in = avr_io_getirq(avr, AVR_IOCTL_UART_GETIRQ('1'), UART_IRQ_INPUT);
     }
-
-    int slave;
     char path[256];
-    if (openpty(&master, &slave, path, NULL, NULL) < 0) fail("openpty");
-    struct termios tio;
-    tcgetattr(slave, &tio);
-    cfmakeraw(&tio);
-    tcsetattr(slave, TCSANOW, &tio);
-    fcntl(master, F_SETFL, fcntl(master, F_GETFL) | O_NONBLOCK);
-    /* The slave stays open here, so the line does not hang up between a host's sessions. */
-    avr_cycle_timer_register(avr, POLL_CYCLES, serve_pty, NULL);
+    line_open(path, sizeof path);
     struct sigaction reset = {.sa_handler = press_reset, .sa_flags = SA_RESTART};
     sigemptyset(&reset.sa_mask);
     sigaction(SIGUSR1, &reset, NULL);
+    struct sigaction hang = {.sa_handler = press_hang, .sa_flags = SA_RESTART};
+    sigemptyset(&hang.sa_mask);
+    sigaction(SIGUSR2, &hang, NULL);
     /* The firmware's start-up first: its INFO is whole in the pty when a host opens it (a
      * host that opens it mid-frame would count the frame's tail as damaged). */
     int announced = 0;
     for (;;) {
         int state = avr_run(avr);
         if (state == cpu_Done || state == cpu_Crashed) return state == cpu_Done ? 0 : 1;
-        if (reset_pressed) reset_board();
-        if (!announced && avr->cycle >= START_CYCLES && !queue_size(&to_host)) {
+        if (trace) trace_pins();
+        if (reset_pressed) {
+            reset_pressed = 0;
+            avr_reset(avr);
+            avr->data[MCUSR] = EXTRF; /* the reset button's flag, as the chip sets it */
+        }
+        if (hang_pressed && hang_at) hang_main_loop();
+        if (!announced && avr->cycle >= START_CYCLES && !line_to_host()) {
             announced = 1;
             printf("uart0 at %s\n", path);
             fflush(stdout);

@@ -4,17 +4,22 @@
  *
  * Timer1 runs the valve's PWM on D11 (OC1A): 8333 ticks of 4 µs, 33.332 ms (the book's
  * 1/30 s to 0.01 %). At each period's start its overflow interrupt starts a conversion of
- * the flex sensor's divider on A0; the conversion's interrupt evaluates the PID (2.2)-(2.4)
- * with gains scheduled on the reference (constant, piecewise or fuzzy), anti-windup at the
- * 0-255 range, and writes the period's duty. The pump on D8 runs during a run. */
+ * the flex sensor's divider on A0; the conversion's interrupt takes the code with interrupts
+ * off, then evaluates, with interrupts on, the PID (2.2)-(2.4) with gains scheduled on the
+ * reference (constant, piecewise or fuzzy), anti-windup at the 0-255 range, and writes the
+ * period's duty. The pump on D8 runs during a run. Safe state: the valve's pin off the PWM
+ * and low (closed), the pump off. */
 #include <avr/interrupt.h>
 #include <avr/io.h>
 #include <math.h>
+#include <util/atomic.h>
 
 #include "probe.h"
 #include "protocol.h"
 #include "rig.h"
 #include "uart.h"
+
+RIG_PROGRAM("pneunet");
 
 #define RATE_HZ 30.0f              /* the valve's PWM frequency */
 #define DT (1.0f / RATE_HZ)        /* [s] */
@@ -43,14 +48,18 @@ static float open_loop = -1.0f;
 /* The run. */
 static uint32_t n, steps;
 static float integral, last_error;
+/* The run's outputs may be driven (live: safe() ends it); a step is under way (in_step); a
+ * conversion ended while one was (missed: the run ends). */
+static volatile uint8_t live, in_step, missed;
+static void safe(void);
 
 /* The reference at step n (programs.py's Program.at). */
-static float reference_at(uint32_t step) {
+static float reference_at(uint32_t k) {
     if (shape == CONSTANT) return values[0];
     if (shape == SINUSOID) /* offset - amplitude cos(2π f t): from rest */
-        return values[0] - values[1] * cosf(2.0f * (float)M_PI * values[2] * (float)step * DT);
+        return values[0] - values[1] * cosf(2.0f * (float)M_PI * values[2] * (float)k * DT);
     /* steps: level floor(t / hold), the last held to the end; in periods, t = n / 30 s */
-    float index = floorf((float)step / (values[0] * RATE_HZ) + 1e-6f);
+    float index = floorf((float)k / (values[0] * RATE_HZ) + 1e-6f);
     return values[1 + (index < levels - 1 ? (uint8_t)index : levels - 1)];
 }
 
@@ -75,10 +84,10 @@ ISR(TIMER1_OVF_vect) {
     probe_idle();
 }
 
-ISR(ADC_vect) {
-    if (n >= steps) return; /* at rest (the first conversion after reset) */
-    probe_busy();
-    uint16_t code = ADC;
+/* The PID step (2.2)-(2.4) for the sample `code`, with interrupts on; its duty written with
+ * interrupts off, and only while the run is live (safe() ends that: a step under way when
+ * the outputs went safe does not open the valve again). */
+static void step(uint16_t code) {
     const float deg_per_code = ADC_VREF / 1024.0f / SENSOR_GAIN * DEG_PER_RAD;
     const float deg_at_zero = (0.5f * ADC_VREF / 1024.0f - SENSOR_ZERO) / SENSOR_GAIN * DEG_PER_RAD;
     float angle = (float)code * deg_per_code + deg_at_zero; /* mid-step reconstruction */
@@ -104,17 +113,39 @@ ISR(ADC_vect) {
         last_error = error;
     }
     uint8_t count = u >= 255.0f ? 255 : (u <= 0.0f ? 0 : (uint8_t)u); /* floor in [0, 255] */
-    OCR1A = (uint16_t)(((uint32_t)count * TICKS + 127) / 255); /* the period's duty */
-    float sample[3] = {reference, angle, count};
-    rig_sample(sample);
+    uint16_t ticks = (uint16_t)(((uint32_t)count * TICKS + 127) / 255); /* the period's duty */
+    ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+        if (live) OCR1A = ticks; /* the period's duty, only while the run is live */
+    }
+    float *sample = rig_slot();
+    sample[0] = reference, sample[1] = angle, sample[2] = count;
+    rig_sample();
     if (++n >= steps) {
-        TIMSK1 = 0;
-        OCR1A = 0;
-        PORTH &= (uint8_t)~_BV(PH5);
+        ATOMIC_BLOCK(ATOMIC_RESTORESTATE) { safe(); } /* the last step: valve and pump off */
         rig_done();
     }
+}
+
+/* The conversion is done: the sample taken with interrupts off, then the PID with them on
+ * (the UART's receive interrupt comes within a byte). A conversion that ends while a step
+ * is still under way (it overran its period) is not a sample: the run ends. */
+ISR(ADC_vect) {
+    probe_busy();
+    if (in_step) {
+        missed = 1;
+        return;
+    }
+    uint16_t code = ADC;
+    in_step = 1;
+    sei();
+    step(code);
+    cli();
+    in_step = 0;
     probe_idle();
 }
+
+/* The main loop's check of the run: a step that overran its period ends it. */
+static const char *control(void) { return missed ? "a control step missed its 33 ms period" : 0; }
 
 static uint8_t configure(uint8_t kind, const uint8_t *body, uint8_t length, const char **why) {
     if (kind == SET_GAINS) {
@@ -176,31 +207,74 @@ static uint8_t start(float duration, const char **why) {
     steps = (uint32_t)lroundf(periods);
     n = 0;
     integral = last_error = 0.0f;
-    OCR1A = 0;
-    PORTH |= _BV(PH5); /* the pump */
-    TCNT1 = 0;
-    TIFR1 = _BV(TOV1);
-    TIMSK1 = _BV(TOIE1);
+    ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+        missed = in_step = 0;
+        live = 1;
+        OCR1A = 0;
+        TCCR1A |= _BV(COM1A1); /* the valve back on its PWM, at duty 0 */
+        PORTH |= _BV(PH5);     /* the pump */
+        ADCSRA |= _BV(ADIF) | _BV(ADIE); /* a conversion that ended at rest is not a sample */
+        TCNT1 = 0;
+        TIFR1 = _BV(TOV1);
+        TIMSK1 = _BV(TOIE1);
+    }
     return 0;
 }
 
-static void stop(void) {
+/* Valve closed, pump off: no more control ticks or samples, the valve's pin taken off the PWM
+ * and driven low (a fast PWM at duty 0 still pulses once a period). An open-loop output
+ * (SET_OUTPUT) holds for one run only. */
+static void safe(void) {
     TIMSK1 = 0;
+    ADCSRA = (uint8_t)((ADCSRA & ~_BV(ADIE)) | _BV(ADIF)); /* ADIF: cleared by a 1 */
+    live = 0;
+    TCCR1A &= (uint8_t)~_BV(COM1A1);
     OCR1A = 0;
+    PORTB &= (uint8_t)~_BV(PB5);
     PORTH &= (uint8_t)~_BV(PH5);
-    open_loop = -1.0f; /* SET_OUTPUT holds until STOP */
+    open_loop = -1.0f;
+}
+
+/* GET: the gains, the reference and the open-loop output as their SET_ commands carry them
+ * (the output -1 when there is none). */
+static uint8_t setting(uint8_t kind, uint8_t *body) {
+    uint8_t n = 0;
+    if (kind == SET_GAINS) {
+        body[n++] = schedule;
+        body[n++] = rows;
+        for (uint8_t k = 0; k < rows; k++) {
+            for (uint8_t j = 0; j < 3; j++, n += 4) write_float(body, n, gains[k][j]);
+            write_float(body, n, points[k]);
+            n += 4;
+        }
+        return n;
+    }
+    if (kind == SET_REFERENCE) {
+        uint8_t count = shape == STEPS ? (uint8_t)(levels + 1) : (shape == SINUSOID ? 3 : 1);
+        body[n++] = shape;
+        body[n++] = count;
+        for (uint8_t k = 0; k < count; k++, n += 4) write_float(body, n, values[k]);
+        return n;
+    }
+    if (kind == SET_OUTPUT) {
+        body[0] = 0;
+        write_float(body, 1, open_loop);
+        return 5;
+    }
+    return 0xFF;
 }
 
 static const struct rig pneunet = {.kind = 1, .period_us = 33333, .channel_count = 3,
                                    .channels = channels, .configure = configure,
-                                   .start = start, .stop = stop};
+                                   .setting = setting, .start = start, .safe = safe,
+                                   .control = control};
 
 int main(void) {
     uart_init();
     DDRB |= _BV(PB5); /* the valve: D11, OC1A */
     DDRH |= _BV(PH5); /* the pump: D8 */
     ICR1 = TICKS - 1; /* TOP first: the timer starts with its clock (simavr reads TOP then) */
-    TCCR1A = _BV(COM1A1) | _BV(WGM11); /* fast PWM, TOP = ICR1 */
+    TCCR1A = _BV(WGM11); /* fast PWM, TOP = ICR1; on the valve's pin during runs only */
     TCCR1B = _BV(WGM13) | _BV(WGM12) | _BV(CS11) | _BV(CS10); /* 16 MHz / 64 */
     adc_start(0); /* the flex sensor on A0 */
     rig_serve(&pneunet);

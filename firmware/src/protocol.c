@@ -2,21 +2,23 @@
 #include "protocol.h"
 
 #include <string.h>
-#include <util/crc16.h>
 
 #include "uart.h"
 
 static uint16_t device_seq;
-static uint8_t rx[MAX_FRAME + 1]; /* a COBS block: its code byte and the payload */
-static uint8_t rx_length;
-static uint8_t rx_overflow; /* more bytes than a frame holds before the delimiter */
-static uint8_t payload[MAX_FRAME];
+
+/* One byte into CRC-16/CCITT-FALSE (polynomial 0x1021, no reflection): the byte-wise form
+ * of the polynomial's shifts (x^12 + x^5 + 1), about 25 cycles where avr-libc's bit loop
+ * (_crc_xmodem_update) takes about 70. */
+static uint16_t crc_update(uint16_t crc, uint8_t byte) {
+    uint8_t x = (uint8_t)((crc >> 8) ^ byte);
+    x ^= (uint8_t)(x >> 4);
+    return (uint16_t)((crc << 8) ^ ((uint16_t)x << 12) ^ ((uint16_t)x << 5) ^ x);
+}
 
 uint16_t crc16(const uint8_t *data, uint8_t length) {
-    /* CRC-16/CCITT-FALSE is XMODEM's CRC (polynomial 0x1021, no reflection) started at
-     * 0xFFFF; avr-libc's update step is hand-written assembly. */
     uint16_t crc = 0xFFFF;
-    for (uint8_t i = 0; i < length; i++) crc = _crc_xmodem_update(crc, data[i]);
+    for (uint8_t i = 0; i < length; i++) crc = crc_update(crc, data[i]);
     return crc;
 }
 
@@ -49,31 +51,43 @@ void frame_send(uint8_t kind, const uint8_t *body, uint8_t length) {
     uart_write(out, m);
 }
 
-/* The payload of a COBS block in rx, or 0 when it is malformed or longer than a frame. */
-static uint8_t cobs_decode(void) {
-    uint8_t i = 0, n = 0;
-    while (i < rx_length) {
-        uint8_t code = rx[i];
-        if (code == 0 || i + code > rx_length || n + code > sizeof payload) return 0;
-        for (uint8_t k = 1; k < code; k++) payload[n++] = rx[i + k];
-        i = (uint8_t)(i + code);
-        if (code < 0xFF && i < rx_length) payload[n++] = 0;
+/* The frame being received, decoded as its bytes come: the payload so far, the bytes left
+ * in the current COBS block (0: the next byte is a block's code), that code, and the CRC of
+ * the payload but its last two bytes (those are the CRC the sender computed). */
+static uint8_t payload[MAX_FRAME];
+static uint8_t received, left, code, bad;
+static uint16_t crc = 0xFFFF;
+
+/* One decoded byte of the payload; too many mark the frame bad (dropped at its delimiter). */
+static void put(uint8_t byte) {
+    if (received >= sizeof payload) {
+        bad = 1;
+        return;
     }
-    return n;
+    if (received >= 2) crc = crc_update(crc, payload[received - 2]);
+    payload[received++] = byte;
 }
 
 uint8_t frame_receive(uint8_t byte, struct command *out) {
     if (byte != 0) {
-        if (rx_length < sizeof rx) rx[rx_length++] = byte;
-        else rx_overflow = 1; /* too long: dropped at the delimiter */
+        if (bad) return 0;
+        if (left == 0) { /* a block's code: the zero the previous block stood for, first */
+            if (code && code < 0xFF) put(0);
+            code = byte;
+            left = (uint8_t)(byte - 1);
+        } else {
+            put(byte);
+            left--;
+        }
         return 0;
     }
-    uint8_t n = rx_overflow ? 0 : cobs_decode();
-    rx_length = 0;
-    rx_overflow = 0;
-    if (n < 5) return 0;
-    uint16_t crc = (uint16_t)(payload[n - 2] | ((uint16_t)payload[n - 1] << 8));
-    if (crc16(payload, (uint8_t)(n - 2)) != crc) return 0;
+    /* The delimiter: whole blocks, at least type, seq and CRC, and the CRC matches. */
+    uint8_t n = received, ok = !bad && code && left == 0 && n >= 5;
+    uint16_t sent = ok ? (uint16_t)(payload[n - 2] | ((uint16_t)payload[n - 1] << 8)) : 0;
+    ok = ok && sent == crc;
+    received = left = code = bad = 0;
+    crc = 0xFFFF;
+    if (!ok) return 0;
     out->kind = payload[0];
     out->seq = (uint16_t)(payload[1] | ((uint16_t)payload[2] << 8));
     out->body = payload + 3;
@@ -81,17 +95,23 @@ uint8_t frame_receive(uint8_t byte, struct command *out) {
     return 1;
 }
 
+void put_u32(uint8_t *out, uint32_t value) {
+    for (uint8_t k = 0; k < 4; k++) out[k] = (uint8_t)(value >> (8 * k));
+}
+
 void send_ack(uint16_t seq) {
     uint8_t body[2] = {(uint8_t)(seq & 0xFF), (uint8_t)(seq >> 8)};
     frame_send(ACK, body, 2);
 }
 
+uint8_t reply_body[MAX_FRAME - 5];
+
 void send_error(uint16_t seq, uint8_t code, const char *text) {
-    static uint8_t body[MAX_FRAME - 5]; /* a frame's whole body: texts go out whole */
+    uint8_t *body = reply_body; /* a frame's whole body: texts go out whole */
     uint8_t n = 0;
     body[n++] = (uint8_t)(seq & 0xFF);
     body[n++] = (uint8_t)(seq >> 8);
     body[n++] = code;
-    while (*text && n < sizeof body) body[n++] = (uint8_t)*text++;
+    while (*text && n < sizeof reply_body) body[n++] = (uint8_t)*text++;
     frame_send(ERROR, body, n);
 }

@@ -9,18 +9,26 @@
  * streams roll, pitch, yaw at 100 Hz on Serial1, 115 200 baud, as frames A5 5A, three
  * float32 [deg], a byte sum) gives a sample per frame: its tilt as the bending vector
  * (bend_x, bend_y) [deg]. The side must be a chamber's (a multiple of 60°) at the supply
- * pressure: partial pressures need chamber pressure sensors the book's rig does not have. */
+ * pressure: partial pressures need chamber pressure sensors the book's rig does not have.
+ *
+ * The tick's interrupt only plays the valve events the main loop scheduled at START, as a
+ * timer's compare output would; everything else (the sensor's frames into samples, the
+ * checks) runs in the main loop. Safe state: pump off, every chamber venting. A run ends in
+ * it with an error when the sensor has sent no frame for SENSOR_TIMEOUT_MS. */
 #include <avr/interrupt.h>
 #include <avr/io.h>
 #include <avr/pgmspace.h>
 #include <math.h>
 #include <string.h>
+#include <util/atomic.h>
 
 #include "fill_table.h"
 #include "probe.h"
 #include "protocol.h"
 #include "rig.h"
 #include "uart.h"
+
+RIG_PROGRAM("six_chamber");
 
 #define TICK_HZ 10000.0f /* the valve sequencer's tick */
 #define TICKS 1600       /* CPU cycles per tick */
@@ -29,6 +37,7 @@
 #define SHAPE_ACTUATION 3 /* programs.py's Shape.ACTUATION */
 #define MAX_EVENTS 8
 #define DEG (180.0f / (float)M_PI)
+#define SENSOR_TIMEOUT_MS 50 /* five of the sensor's periods */
 enum mode { VENT = 0, HOLD = 1, FILL = 2 }; /* plants/six_chamber_sim.py's valve positions */
 
 static const char *const channels[][2] = {{"bend_x", "deg"}, {"bend_y", "deg"}};
@@ -41,37 +50,47 @@ static float delta = 0.0f, pulse_start = 0.0f, pulse_length = 0.0f;
 /* The run: valve events in tick order, the tick, the sensor's samples to take. */
 struct event {
     uint32_t tick;
-    uint8_t chamber, mode;
+    uint8_t port_c; /* the coils' port: 0 PORTA, 1 PORTC */
+    uint8_t mask, bits; /* the chamber's two coils, and those of them on */
 };
 static struct event events[MAX_EVENTS];
 static uint8_t event_count, next_event;
 static volatile uint32_t tick;
 static uint32_t samples_left;
+static uint16_t frame_ms; /* when the sensor's last frame was taken (rig_clock_ms) */
 
 /* The sensor's frame, filled by the Serial1 interrupt, taken by the main loop. */
 static uint8_t frame[12];
 static volatile uint8_t frame_ready;
 
-/* A chamber's valve coils (fill, vent). */
-static void set_valve(uint8_t chamber, uint8_t mode) {
+/* A chamber's valve coils (fill, vent) in `mode`, as an event: its port, the two coils'
+ * bits and those of them on. */
+static struct event coils(uint8_t chamber, uint8_t mode) {
     uint8_t fill = mode == FILL, vent = mode == VENT;
-    if (chamber < 4) {
-        uint8_t bits = (uint8_t)(fill << (2 * chamber) | vent << (2 * chamber + 1));
-        PORTA = (uint8_t)((PORTA & ~(3 << (2 * chamber))) | bits);
-    } else { /* D30 = PC7, D31 = PC6, D32 = PC5, D33 = PC4 */
-        uint8_t at = (uint8_t)(7 - 2 * (chamber - 4));
-        uint8_t bits = (uint8_t)(fill << at | vent << (at - 1));
-        PORTC = (uint8_t)((PORTC & ~(3 << (at - 1))) | bits);
-    }
+    if (chamber < 4)
+        return (struct event){0, 0, (uint8_t)(3 << (2 * chamber)),
+                              (uint8_t)(fill << (2 * chamber) | vent << (2 * chamber + 1))};
+    uint8_t at = (uint8_t)(7 - 2 * (chamber - 4)); /* D30 = PC7, D31 = PC6, D32 = PC5, D33 = PC4 */
+    return (struct event){0, 1, (uint8_t)(3 << (at - 1)), (uint8_t)(fill << at | vent << (at - 1))};
 }
 
+/* An event's coils set (a port's read-modify-write: the caller keeps interrupts out). */
+static void apply(const struct event *e) {
+    if (e->port_c) PORTC = (uint8_t)((PORTC & ~e->mask) | e->bits);
+    else PORTA = (uint8_t)((PORTA & ~e->mask) | e->bits);
+}
+
+static void set_valve(uint8_t chamber, uint8_t mode) {
+    struct event e = coils(chamber, mode);
+    apply(&e);
+}
+
+/* The 10 kHz tick: the events that are due, their coils precomputed at START (a few dozen
+ * cycles, so that the host's bytes are never kept waiting). */
 ISR(TIMER1_COMPA_vect) {
     probe_busy();
     uint32_t now = ++tick;
-    while (next_event < event_count && events[next_event].tick <= now) {
-        set_valve(events[next_event].chamber, events[next_event].mode);
-        next_event++;
-    }
+    while (next_event < event_count && events[next_event].tick <= now) apply(&events[next_event++]);
     probe_idle();
 }
 
@@ -83,7 +102,7 @@ ISR(USART1_RX_vect) {
     else if (at == 1) at = byte == 0x5A ? 2 : (byte == 0xA5);
     else if (at < 14) buffer[at - 2] = byte, sum = (uint8_t)(at == 2 ? byte : sum + byte), at++;
     else {
-        if (byte == sum && !frame_ready) memcpy(frame, buffer, 12), frame_ready = 1;
+        if (byte == sum && !frame_ready) memcpy(frame, buffer, 12), frame_ready = 1, rig_event = 1;
         at = 0;
     }
 }
@@ -100,15 +119,22 @@ static float fill_time(float fraction) {
 }
 
 static void add_event(float seconds, uint8_t chamber, uint8_t mode) {
-    struct event e = {tick_at(seconds), chamber, mode};
+    struct event e = coils(chamber, mode);
+    e.tick = tick_at(seconds);
     uint8_t k = event_count++;
     while (k > 0 && events[k - 1].tick > e.tick) events[k] = events[k - 1], k--; /* stable */
     events[k] = e;
 }
 
-/* Off the interrupts: a sensor frame into a sample, the bending vector of the top's tilt. */
-static void background(void) {
-    if (!frame_ready || !samples_left) return;
+/* The run's main-loop work: a sensor frame into a sample, the bending vector of the top's
+ * tilt; a sensor that went quiet ends the run. */
+static const char *control(void) {
+    if (!frame_ready) {
+        if ((uint16_t)(rig_clock_ms() - frame_ms) > SENSOR_TIMEOUT_MS)
+            return "no frame from the orientation sensor for 50 ms";
+        return 0;
+    }
+    frame_ms = rig_clock_ms();
     float roll = read_float(frame, 0) / DEG, pitch = read_float(frame, 4) / DEG;
     float yaw = read_float(frame, 8) / DEG;
     frame_ready = 0;
@@ -117,9 +143,11 @@ static void background(void) {
     float nx = cr * sp * cy + sr * sy, ny = cr * sp * sy - sr * cy, nz = cr * cosf(pitch);
     float horizontal = sqrtf(nx * nx + ny * ny);
     float scale = horizontal > 0.0f ? atan2f(horizontal, nz) / horizontal : 1.0f;
-    float bend[2] = {nx * scale * DEG, ny * scale * DEG};
-    rig_sample(bend);
+    float *bend = rig_slot();
+    bend[0] = nx * scale * DEG, bend[1] = ny * scale * DEG;
+    rig_sample();
     if (--samples_left == 0) rig_done();
+    return 0;
 }
 
 static uint8_t configure(uint8_t kind, const uint8_t *body, uint8_t length, const char **why) {
@@ -170,27 +198,51 @@ static uint8_t start(float duration, const char **why) {
         add_event(at + open, opposite, HOLD);
         add_event(at + (pulse_length > open ? pulse_length : open), opposite, VENT);
     }
-    for (uint8_t c = 0; c < CHAMBERS; c++) set_valve(c, c == chamber ? FILL : VENT);
-    frame_ready = 0;
-    tick = 0;
-    PORTH |= _BV(PH5); /* the pump */
-    TCNT1 = 0;
-    TIFR1 = _BV(OCF1A);
-    TIMSK1 = _BV(OCIE1A);
+    frame_ms = rig_clock_ms();
+    ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+        for (uint8_t c = 0; c < CHAMBERS; c++) set_valve(c, c == chamber ? FILL : VENT);
+        frame_ready = 0;
+        tick = 0;
+        PORTH |= _BV(PH5); /* the pump */
+        TCNT1 = 0;
+        TIFR1 = _BV(OCF1A);
+        TIMSK1 = _BV(OCIE1A);
+    }
     return 0;
 }
 
-static void stop(void) {
+/* Pump off and every chamber venting: no more valve events, none pending. */
+static void safe(void) {
     TIMSK1 = 0;
+    TIFR1 = _BV(OCF1A);
     samples_left = 0;
     PORTH &= (uint8_t)~_BV(PH5);
     for (uint8_t c = 0; c < CHAMBERS; c++) set_valve(c, VENT);
 }
 
+/* GET: the actuation and the damping policy as SET_REFERENCE and SET_DAMPING carry them. */
+static uint8_t setting(uint8_t kind, uint8_t *body) {
+    if (kind == SET_REFERENCE) {
+        body[0] = SHAPE_ACTUATION;
+        body[1] = 3;
+        write_float(body, 2, side);
+        write_float(body, 6, gauge);
+        write_float(body, 10, hold);
+        return 14;
+    }
+    if (kind == SET_DAMPING) {
+        write_float(body, 0, delta);
+        write_float(body, 4, pulse_start);
+        write_float(body, 8, pulse_length);
+        return 12;
+    }
+    return 0xFF;
+}
+
 static const struct rig six_chamber = {.kind = 2, .period_us = 10000, .channel_count = 2,
                                        .channels = channels, .configure = configure,
-                                       .start = start, .stop = stop,
-                                       .background = background};
+                                       .setting = setting, .start = start, .safe = safe,
+                                       .control = control};
 
 int main(void) {
     uart_init();

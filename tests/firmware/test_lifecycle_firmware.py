@@ -63,7 +63,7 @@ class ResetAt:
 
     def __init__(self, at: int) -> None:
         self.plant, self.at, self.periods = PneuNetPins(), at, 0
-        self.tick_us = self.plant.tick_us
+        self.tick_us, self.program = self.plant.tick_us, self.plant.program
         self.rig: FirmwareRig | None = None
 
     def start(self, seed: int) -> None:
@@ -126,3 +126,11 @@ def test_emulate_with_firmware_stopped_by_sigterm_stops_its_harness(emulated):
         proc.wait(10)
         for pid in filter(_alive, harness):  # the test leaves no harness behind either way
             os.kill(pid, signal.SIGKILL)
+
+
+def test_another_rigs_firmware_is_refused_before_simavr_starts(built, cli):
+    proc = cli("emulate", "motor", "--firmware", built / "pneunet.elf")
+    assert proc.returncode == 2
+    assert proc.stderr.splitlines() == [
+        f"error: --firmware: {built / 'pneunet.elf'} is the pneunet firmware, not the motor "
+        "rig's; use firmware/build/motor.elf (make -C firmware)"]  # fmt: skip

@@ -99,3 +99,8 @@ def test_emulate_motor_with_firmware_runs_a_figure_from_the_command_line(emulate
     here = simulate_batch(figure_config("fig4_8"), trials=1)[1]
     assert record["metrics"]["speed_mean"] == pytest.approx(float(here["speed_mean"][0]),
                                                             rel=1e-3)  # fmt: skip
+    # What the sensor alone cannot measure is left out, not given another meaning.
+    assert record["metrics"]["current_rms_error"] is None
+    assert record["metrics"]["noise_rms"] is None
+    table = cli("rig", "run", path, config, "--out", tmp_path / "table").stdout
+    assert next(line for line in table.splitlines() if "noise_rms" in line).split()[-2] == "—"

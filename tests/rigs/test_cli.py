@@ -7,6 +7,7 @@ import json
 import signal
 import subprocess
 import time
+from pathlib import Path
 
 import pyarrow.parquet as pq
 import pytest
@@ -79,6 +80,15 @@ ENDINGS = {  # how a run is cut short: exit status, and what its one line says
 }
 
 
+def wait_for_samples(journal: Path, count: int, run: subprocess.Popen) -> None:
+    """Until the run's telemetry.csv holds `count` samples (it is flushed every 0.1 s)."""
+    while run.poll() is None:
+        if journal.is_file() and len(journal.read_text().splitlines()) > count:
+            return
+        time.sleep(0.05)  # polling the file: what is awaited is its content, not a time
+    raise AssertionError(f"the run ended first: {run.stderr.read()}")
+
+
 @pytest.mark.parametrize("ending", list(ENDINGS))
 def test_a_run_cut_short_keeps_what_came_and_says_why(pid_config, tmp_path, ending):
     options = ["--realtime", "--faults", "reset_at=1.0"] if ending == "reset" else ["--realtime"]
@@ -88,7 +98,8 @@ def test_a_run_cut_short_keeps_what_came_and_says_why(pid_config, tmp_path, endi
         run = subprocess.Popen([ARTICULA, "rig", "run", path, pid_config, "--out",
                                 tmp_path / "run"], stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True)  # fmt: skip
-        time.sleep(1.5)
+        if ending != "reset":  # act once samples have come: the run is under way
+            wait_for_samples(tmp_path / "run" / "telemetry.csv", 15, run)
         if ending == "unplug":
             emulator.kill()
         elif ending == "ctrl-c":
@@ -108,7 +119,7 @@ def test_rig_info_of_an_emulated_pneunet(emulated_pneunet, cli):
     proc = cli("rig", "info", emulated_pneunet, "--json")
     assert proc.returncode == 0, proc.stderr
     info = json.loads(proc.stdout)
-    assert info["rig"] == "pneunet" and info["protocol"] == 1
+    assert info["rig"] == "pneunet" and info["protocol"] == 2 and info["reset"] == "power-on"
     assert [c["unit"] for c in info["channels"]] == ["deg", "deg", "counts"]
     text = cli("rig", "info", emulated_pneunet).stdout
     assert "angle [deg]" in text
@@ -142,6 +153,46 @@ def test_a_port_that_does_not_open_leaves_no_output_folder(cli, tmp_path, comman
     proc = cli("rig", verb, "/dev/no-such-rig", *rest, "--out", tmp_path / "out")
     assert proc.returncode == 2 and "cannot open the port" in proc.stderr, proc.stderr
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(
+    ("content", "words"),
+    [
+        (b"", "is empty, not a firmware ELF"),
+        (b"\x12\x9a" * 500, "is not an ELF file"),
+        (
+            b"\x7fELF\x02\x01\x01" + bytes(9) + b"\x02\x00\x3e\x00" + bytes(44),
+            "is an ELF for x86-64, not for the AVR",
+        ),
+    ],
+    ids=["empty", "random", "x86-64"],
+)
+def test_a_firmware_file_that_is_not_the_rigs_is_refused_naming_it(cli, tmp_path, content,
+                                                                    words):  # fmt: skip
+    elf = tmp_path / "motor.elf"
+    elf.write_bytes(content)
+    proc = cli("emulate", "motor", "--firmware", elf)
+    assert proc.returncode == 2
+    assert proc.stderr.splitlines() == [proc.stderr.strip()]  # one line
+    assert f"error: --firmware: {elf} {words}" in proc.stderr
+
+
+def test_a_recording_runs_again_from_its_config(emulated_pneunet, cli, tmp_path):
+    settings = tmp_path / "pid.toml"
+    settings.write_text(PID_CONFIG)  # leaves its gains and sinusoid on the rig
+    assert cli("rig", "run", emulated_pneunet, settings, "--out", tmp_path / "pid").returncode == 0
+    first = cli("rig", "record", emulated_pneunet, "--duration", "1", "--seed", "4", "--out",
+                tmp_path / "rec", "--json")  # fmt: skip
+    assert first.returncode == 0, first.stderr
+    config = tmp_path / "rec" / "config.toml"
+    text = config.read_text()
+    assert 'experiment = "rig.record"' in text and "[settings.gains]" in text
+    assert 'shape = "sinusoid"' in text  # what the rig held: PID_CONFIG's reference
+    again = cli("rig", "run", emulated_pneunet, config, "--out", tmp_path / "again", "--json")
+    assert again.returncode == 0, again.stderr
+    traces = [pq.read_table(tmp_path / name / "trace.parquet").to_pydict()
+              for name in ("rec", "again")]  # fmt: skip
+    assert traces[0] == traces[1] and len(traces[0]["t"]) == 30
 
 
 def test_rig_tune_reaches_the_in_process_gains(emulated_pneunet, cli, tmp_path):

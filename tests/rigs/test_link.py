@@ -5,6 +5,7 @@ never in the trace, a device reset caught."""
 from __future__ import annotations
 
 import os
+import struct
 
 import numpy as np
 import pytest
@@ -17,7 +18,8 @@ from articula.rigs.emulator import Emulator, Faults
 from articula.rigs.link import DeviceResetError, Link
 from articula.rigs.pneunet import PneuNetDevice, PneuNetRig
 from articula.rigs.programs import steps
-from articula.rigs.protocol import Info, RigKind
+from articula.rigs.protocol import Info, Kind, RigKind, RunEnd
+from articula.rigs.run import run_program
 
 PARAMS = PneuNetParams()
 LEVELS, HOLD = (30.0, 60.0), 2.0
@@ -135,3 +137,26 @@ def test_a_rig_that_never_answers_a_command_stops_the_run():
     emulator = Emulator(PneuNetDevice(PARAMS), faults=Faults(delay_ms=400))
     with emulator, pytest.raises(PortError, match="no answer to HELLO after 2 tries"):
         Link(emulator.path, timeout=0.1, retries=1)
+
+
+def test_the_emulated_device_stops_a_run_when_the_host_goes_silent():
+    emulator = Emulator(PneuNetDevice(PARAMS), realtime=True)
+    with emulator, Link(emulator.path) as link:
+        start = link.command(Kind.START, struct.pack("<fIH", 10.0, 0, 100), fresh=True)
+        for _ in range(1000):  # only reading: TELEMETRY, then the device's own end
+            frame = link.next_frame(2.0)
+            assert frame is not None, "the run went on without the host"
+            if frame.kind == Kind.ERROR:
+                break
+        assert int.from_bytes(frame.body[:2], "little") == start and frame.body[2] == 5
+        assert b"host_timeout_ms" in frame.body
+        status = link.status()
+        assert not status.running and status.ended == RunEnd.HOST_TIMEOUT
+        assert 1 <= status.samples <= 10  # about 100 ms at 30 Hz, not the 10 s asked
+
+
+def test_a_run_with_heartbeats_outlives_the_host_timeout():
+    emulator = Emulator(PneuNetDevice(PARAMS), realtime=True)
+    with emulator, Link(emulator.path) as link:
+        t, _ = run_program(link, 0.5, 0, host_timeout_ms=100)
+        assert len(t) == 15 and link.status().ended == RunEnd.DONE

@@ -153,6 +153,7 @@ def info(port: Port, as_json: JsonFlag = False) -> None:
         "firmware": ".".join(map(str, i.firmware)),
         "sample_period_s": i.sample_period_us * 1e-6,
         "channels": [{"name": c.name, "unit": c.unit} for c in i.channels],
+        "reset": i.reset.name.lower().replace("_", "-"),
     }
     if as_json:
         emit_json(summary)
@@ -161,6 +162,7 @@ def info(port: Port, as_json: JsonFlag = False) -> None:
               f"{summary['firmware']}, a sample every {i.sample_period_us} µs")  # fmt: skip
     for c in i.channels:
         out.print(escape(f"  {c.name} [{c.unit}]"))
+    out.print(f"last started by: {summary['reset']}")
 
 
 RIG_RUNS = {  # experiment -> (its driver, the rig it needs)
@@ -180,6 +182,9 @@ def run_(
 ) -> None:
     """Run an experiment config on the rig; the run folder is written as samples arrive.
 
+    A `rig record` folder's config.toml (experiment "rig.record") runs again with the settings
+    it recorded.
+
     \b
     Example: articula rig run /dev/ttyACM0 my_pid.toml --out runs/rig"""
     import importlib
@@ -193,6 +198,9 @@ def run_(
     from articula.validation import load_toml
 
     data = with_absolute_paths(load_toml(config), config.parent)
+    if data.get("experiment") == "rig.record":
+        _repeat_recording(port, data, config, out_dir, force, as_json)
+        return
     exp, cfg = parse_config(data, str(config))
     if exp.name not in RIG_RUNS:
         raise ConfigError("experiment", f"{exp.name} does not run on a rig yet; rig runs: "
@@ -214,6 +222,33 @@ def run_(
               f"{lost['dropped']} lost, {lost['resends']} resent; in {out_dir}")  # fmt: skip
 
 
+def _repeat_recording(port: str, data: dict, config: Path, out_dir: Path, force: bool,
+                      as_json: bool) -> None:  # fmt: skip
+    """`rig run` of a recording's config.toml: its settings sent, its run again."""
+    from articula.rigs.link import Link
+    from articula.rigs.recorder import Recorder
+    from articula.rigs.recording import parse_recording
+    from articula.rigs.run import run_program
+    from articula.runs.folders import check_out, claimed
+
+    recording = parse_recording(data, str(config))
+    check_out(out_dir, "run", force)
+    with Link(port, recording["rig"]) as link, claimed(out_dir, "run", force):
+        recorder = Recorder(out_dir, data, [c.name for c in link.info.channels])
+
+        def take() -> dict[str, float]:
+            for kind, body in recording["bodies"]:
+                link.command(kind, body)
+            run_program(link, recording["duration"], recording["seed"], recorder.add)
+            return {}  # a recording has no metrics
+
+        summary = recorder.capture(take, link.stats)
+    if as_json:
+        emit_json(summary)
+        return
+    out.print(f"{summary['samples']} samples as recorded in {config} in {out_dir}")
+
+
 @rig_app.command()
 def record(
     port: Port,
@@ -225,19 +260,21 @@ def record(
 ) -> None:
     """Run the rig with what it holds (gains, reference) and record every channel.
 
+    The settings it ran (read back from the rig) go into the folder's config.toml, which
+    `articula rig run` takes to repeat the recording.
+
     \b
     Example: articula rig record /dev/ttyACM0 --duration 10 --out runs/record"""
     from articula.rigs.link import Link
     from articula.rigs.recorder import Recorder
+    from articula.rigs.recording import recording_config
     from articula.rigs.run import run_program
     from articula.runs.folders import check_out, claimed
 
     check_out(out_dir, "run", force)
     with Link(port) as link, claimed(out_dir, "run", force):
         channels = [c.name for c in link.info.channels]
-        config = {"experiment": "rig.record", "port": port, "duration": duration, "seed": seed,
-                  "rig": link.info.rig.name.lower()}  # fmt: skip
-        recorder = Recorder(out_dir, config, channels)
+        recorder = Recorder(out_dir, recording_config(link, duration, seed), channels)
 
         def take() -> dict[str, float]:
             run_program(link, duration, seed, recorder.add)

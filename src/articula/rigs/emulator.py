@@ -7,12 +7,18 @@ injected on the device's frames: drop (probability a frame is not sent), corrupt
 one of its bytes is flipped), delay_ms (the latency of every reply to a command: later
 commands are read and answered meanwhile, in order) and reset_at (the
 device restarts at that run time [s]: the run ends, its count starts again from 0 and it
-announces itself with an INFO).
+announces itself with an INFO, its reset cause "external").
+
+As the firmware does, the device ends a run by itself when the host sends no valid frame for
+the START's host_timeout_ms (default 500 ms): it stops and sends an ERROR (code 5, STOPPED)
+naming the START. Its silence clock counts only the time it spends waiting for the line, not
+the time it computes, so a device busy with a long simulation does not blame the host.
 """
 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import os
 import select
 import struct
@@ -28,7 +34,9 @@ import numpy as np
 
 from articula.errors import ConfigError, DeviceError
 from articula.rigs import protocol
-from articula.rigs.protocol import ErrorCode, Frame, Info, Kind
+from articula.rigs.protocol import ErrorCode, Frame, Info, Kind, ResetCause, RunEnd
+
+HOST_TIMEOUT_MS = 500  # START's default
 
 
 class Device(Protocol):
@@ -57,6 +65,16 @@ class Device(Protocol):
 
         Returns:
             One value per channel of `info`, shape (channels,); None when the run is over.
+        """
+
+    def setting(self, kind: int) -> bytes:
+        """A setting as its SET_ command carries it (GET); DeviceError for one it has not.
+
+        Args:
+            kind: the SET_ command's message type.
+
+        Returns:
+            The body the device holds for it.
         """
 
     def stop(self) -> None:
@@ -162,6 +180,9 @@ class Emulator:
         self._run: tuple[int, int, float] | None = None  # (START's seq, samples, start time)
         self._last_start: int | None = None  # the START last carried out (a resend is not)
         self._samples = 0  # samples of the last run
+        self._ended = RunEnd.NOT_ENDED
+        self._host_timeout = HOST_TIMEOUT_MS * 1e-3  # [s] of the run going on
+        self._quiet = 0.0  # [s] spent waiting for the line since the host's last frame
         self._decimation = 1
         self._thread: threading.Thread | None = None
         self._replies: deque[tuple[float, Kind, bytes]] = deque()  # (when due, kind, body)
@@ -173,7 +194,9 @@ class Emulator:
             wait = 0.0 if busy and not self.realtime else (self._due() if busy else 0.05)
             if self._replies:
                 wait = min(wait, self._replies[0][0] - time.monotonic())
+            waited = time.monotonic()
             ready, _, _ = select.select([self._master], [], [], max(wait, 0.0))
+            self._quiet += time.monotonic() - waited
             if ready:
                 try:
                     data = os.read(self._master, 4096)
@@ -181,6 +204,8 @@ class Emulator:
                     return  # the pty is gone
                 for raw in self._deframer.feed(data):
                     self._handle(raw)
+            if self._run is not None and self._quiet >= self._host_timeout:
+                self._end_by_itself("no frame from the host within host_timeout_ms; outputs off")
             while self._replies and self._replies[0][0] <= time.monotonic():
                 _, kind, body = self._replies.popleft()
                 self._send(kind, body)
@@ -220,12 +245,20 @@ class Emulator:
         period = self.device.info.sample_period_us * 1e-6
         return started + samples * period - time.monotonic()
 
+    def _end_by_itself(self, why: str) -> None:
+        """The device ends the run (safe state) and says why, naming its START."""
+        seq, samples, _ = self._run
+        self.device.stop()
+        self._run, self._samples, self._ended = None, samples, RunEnd.HOST_TIMEOUT
+        self._send(Kind.ERROR, struct.pack("<HB", seq, ErrorCode.STOPPED) + why.encode())
+
     def _handle(self, raw: bytes) -> None:
         """Decode one command and answer it (a damaged one is ignored: the host resends)."""
         try:
             frame = protocol.decode(raw)
         except DeviceError:
             return
+        self._quiet = 0.0
         try:
             self._execute(frame)
         except (DeviceError, struct.error) as exc:
@@ -242,15 +275,21 @@ class Emulator:
             if self._run is not None and self._run[0] != frame.seq:
                 raise DeviceError("a run is going on; STOP it first")
             if frame.seq != self._last_start:  # a START sent again is only acknowledged
-                duration, seed = struct.unpack("<fI", frame.body)
+                duration, seed, timeout = _start(frame.body)
                 self.device.start(duration, seed)
                 self._run, self._last_start = (frame.seq, 0, time.monotonic()), frame.seq
+                self._host_timeout, self._ended = timeout * 1e-3, RunEnd.NOT_ENDED
         elif frame.kind == Kind.STATUS:
             samples = self._run[1] if self._run is not None else self._samples
-            status = struct.pack("<BI", self._run is not None, samples)
+            status = struct.pack("<BIHB", self._run is not None, samples, 0, self._ended)
+        elif frame.kind == Kind.GET:
+            if len(frame.body) != 1:
+                raise DeviceError("GET takes the type of a SET_ command (u8)")
+            status = self.device.setting(frame.body[0])
         elif frame.kind == Kind.STOP:
             self.device.stop()
-            self._run = None
+            if self._run is not None:
+                self._run, self._samples, self._ended = None, self._run[1], RunEnd.STOP
         elif frame.kind == Kind.STREAM:
             (self._decimation,) = struct.unpack("<H", frame.body)
         else:
@@ -266,11 +305,12 @@ class Emulator:
             self._run, self._seq, self._last_start = None, 0, None
             self._replies.clear()  # what a device had not sent yet dies with it
             self.faults = Faults(self.faults.drop, self.faults.corrupt, self.faults.delay_ms)
-            self._send(Kind.INFO, protocol.encode_info(self.device.info))
+            info = dataclasses.replace(self.device.info, reset=ResetCause.EXTERNAL)
+            self._send(Kind.INFO, protocol.encode_info(info))
             return
         values = self.device.sample()
         if values is None:
-            self._run, self._samples = None, samples
+            self._run, self._samples, self._ended = None, samples, RunEnd.DONE
             self._send(Kind.DONE, struct.pack("<HI", seq, samples))
             return
         self._run = (seq, samples + 1, started)
@@ -300,3 +340,14 @@ class Emulator:
             os.write(self._master, wire)
         except OSError:
             self._stopped.set()  # the pty is gone
+
+
+def _start(body: bytes) -> tuple[float, int, int]:
+    """START's duration [s], seed and host timeout [ms]; DeviceError when it does not decode."""
+    if len(body) not in (8, 10):
+        raise DeviceError("START takes a duration, a seed and host_timeout_ms")
+    duration, seed = struct.unpack_from("<fI", body)
+    timeout = struct.unpack_from("<H", body, 8)[0] if len(body) == 10 else HOST_TIMEOUT_MS
+    if not 20 <= timeout <= 60000:
+        raise DeviceError("START: host_timeout_ms must be 20-60000")
+    return duration, seed, timeout

@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import NamedTuple, Protocol
 
 from articula.errors import ConfigError, DeviceError
+from articula.rigs.elf import check_firmware
 
 BUILD_HINT = "build it with: make -C firmware (needs apt-get install -y gcc-avr avr-libc " \
     "simavr libsimavr-dev)"  # fmt: skip
@@ -38,7 +39,10 @@ class Pins(NamedTuple):
         ocr1a: Timer1's PWM compare register (duty) [counts].
         ocr3a: Timer3's PWM compare register (duty) [counts].
         ocr4a: Timer4's PWM compare register (duty) [counts].
-        step_cycles: CPU cycles the previous control step took.
+        step_cycles: CPU cycles the previous control step took (its marked interrupts
+            and its main-loop part, interrupts that came meanwhile included).
+        step_latency: CPU cycles from the previous sample's interrupt to the end of its
+            main-loop control step (0 for a rig without one).
     """
 
     adc_channel: int  # the channel the starting conversion reads (255: a tick, none)
@@ -49,6 +53,7 @@ class Pins(NamedTuple):
     ocr3a: int
     ocr4a: int
     step_cycles: int  # CPU cycles the previous control step took
+    step_latency: int  # from its sample's interrupt to the end of its control step
 
 
 class Inputs(NamedTuple):
@@ -69,6 +74,7 @@ class PinPlant(Protocol):
     """A simulated plant behind the firmware's pins."""
 
     tick_us: int | None  # the plant's own step [µs]; None: a step per ADC conversion
+    program: str  # the firmware it is built for: "motor", "pneunet" or "six_chamber"
 
     def start(self, seed: int) -> None:
         """A run starts: the plant at rest, its noise drawn from `seed`.
@@ -92,23 +98,36 @@ class PinPlant(Protocol):
 class FirmwareRig:
     """A firmware ELF in the harness with its plant; `path` is the port the host opens.
 
+    The ELF is checked first (rigs/elf.py: an AVR ELF of articula's program for the plant's
+    rig; ConfigError naming the file otherwise), so simavr never sees another file.
+
     Args:
         elf: the firmware (firmware/build/<rig>.elf); the harness is found beside it.
         plant: the simulated plant its pins drive and read.
         realtime: keep the wall clock's pace during runs (default: as fast as it goes).
+        trace: a file for the harness's trace of the pins and the line (rigs/pin_trace.py);
+            None: no trace.
     """
 
-    def __init__(self, elf: Path, plant: PinPlant, realtime: bool = False) -> None:
+    def __init__(
+        self, elf: Path, plant: PinPlant, realtime: bool = False, trace: Path | None = None
+    ) -> None:
         elf = Path(elf)
         harness = elf.parent / "harness"
-        for what in (elf, harness):
-            if not what.is_file():
-                raise ConfigError("--firmware", f"{what} does not exist; {BUILD_HINT}")
+        if not elf.is_file():
+            raise ConfigError("--firmware", f"{elf} does not exist; {BUILD_HINT}")
+        check_firmware(elf, plant.program)
+        if not harness.is_file():
+            raise ConfigError("--firmware", f"{harness} does not exist beside {elf.name}; "
+                              f"{BUILD_HINT}")  # fmt: skip
         self.plant = plant
         self.step_cycles: list[int] = []  # per control period of the last run
+        self.step_latency: list[int] = []
         args = [str(harness), str(elf), "--plant"] + (["--realtime"] if realtime else [])
         if plant.tick_us is not None:
             args += ["--tick-us", str(plant.tick_us)]
+        if trace is not None:
+            args += ["--trace", str(trace)]
         self._proc = subprocess.Popen(args, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                       text=True, bufsize=1)  # fmt: skip
         self.path = self._read_path()
@@ -129,10 +148,11 @@ class FirmwareRig:
             word, *numbers = line.split()
             if word == "run":
                 self.plant.start(int(numbers[0]))
-                self.step_cycles = []
+                self.step_cycles, self.step_latency = [], []
             elif word == "sample":
                 pins = Pins(*map(int, numbers))
                 self.step_cycles.append(pins.step_cycles)
+                self.step_latency.append(pins.step_latency)
                 inputs = self.plant.period(pins)
                 reply = f"{inputs.adc_code} {inputs.encoder_count} {inputs.serial1.hex()}\n"
                 try:
@@ -145,6 +165,11 @@ class FirmwareRig:
         """Reset the board, as its reset button does: the firmware starts again (and says so
         with an INFO unasked); a run going on ends."""
         self._proc.send_signal(signal.SIGUSR1)
+
+    def hang(self) -> None:
+        """Hang the firmware's main loop, as a bug's endless loop would (its interrupts go
+        on): the watchdog should put the outputs off and reset the board."""
+        self._proc.send_signal(signal.SIGUSR2)
 
     def close(self) -> None:
         """Stop the harness (the port goes away)."""

@@ -7,6 +7,11 @@ up (DeviceError). Device frames carry the device's own sequence numbers: a gap c
 frames lost on the way, a damaged frame is counted and skipped (the deframer picks up at the
 next delimiter), and an INFO nobody asked for, or a count that starts again from 0, is a
 device reset (DeviceResetError): a run never silently goes on across one.
+
+Every wait has a deadline and every buffer a bound: a command waits at most (retries + 1)
+· timeout, a write at most WRITE_TIMEOUT; the frames not yet taken are at most MAX_INBOX. An
+intact frame that breaks the protocol (a TELEMETRY body of the wrong length, an INFO longer
+than a frame, a type the protocol does not have) is a DeviceError naming what came.
 """
 
 from __future__ import annotations
@@ -20,13 +25,34 @@ import serial
 
 from articula.errors import DeviceError, PortError
 from articula.rigs import protocol
-from articula.rigs.protocol import PROTOCOL_VERSION, Frame, Info, Kind, RigKind
+from articula.rigs.protocol import (
+    PROTOCOL_VERSION,
+    Frame,
+    FrameError,
+    Info,
+    Kind,
+    ResetCause,
+    RigKind,
+    RunEnd,
+)
 
 BAUD = 1_000_000  # the ATmega16U2 USB bridge of the Mega 2560 runs this rate (docs/protocol.md)
+WRITE_TIMEOUT = 1.0  # [s] a device that takes no bytes for this long has stopped reading
+MAX_INBOX = 4096  # device frames waiting to be taken; more: the device floods the line
+RESET_WORDS = {
+    ResetCause.POWER_ON: "a power loss",
+    ResetCause.EXTERNAL: "its reset pin: the button, the USB line or the emulator",
+    ResetCause.WATCHDOG: "its watchdog: the program stopped; its outputs went off",
+    ResetCause.BROWN_OUT: "its supply dropped (brown-out)",
+}
 
 
 class DeviceResetError(DeviceError):
     """The device restarted (power, watchdog, USB reset) while the host was using it."""
+
+
+class NoAnswerError(DeviceError):
+    """A command got neither its answer nor an ERROR after every resend."""
 
 
 @dataclass
@@ -35,7 +61,7 @@ class LinkStats:
     sent again for want of an acknowledgement.
 
     Attributes:
-        crc_errors: frames dropped as damaged (malformed COBS block or CRC mismatch).
+        crc_errors: frames dropped as damaged (malformed COBS block, CRC mismatch, overlong).
         dropped: device frames missing from the device's sequence numbers.
         resends: commands sent again for want of an ACK or ERROR.
         frames: device frames received intact.
@@ -45,6 +71,24 @@ class LinkStats:
     dropped: int = 0
     resends: int = 0
     frames: int = 0
+
+
+@dataclass(frozen=True)
+class Status:
+    """A device's answer to STATUS.
+
+    Attributes:
+        running: whether a run goes on (its DONE not sent yet).
+        samples: the samples of the current run so far, else of the last one.
+        rx_overruns: bytes from the host the device lost since it started (its USART's data
+            overruns and a full receive queue).
+        ended: how the last run ended.
+    """
+
+    running: bool
+    samples: int
+    rx_overruns: int
+    ended: RunEnd
 
 
 class Link:
@@ -69,16 +113,19 @@ class Link:
         retries: int = 3,
     ) -> None:
         try:
-            self.serial = serial.serial_for_url(port, baudrate=baud, timeout=0.02)
+            self.serial = serial.serial_for_url(port, baudrate=baud, timeout=0.02,
+                                                write_timeout=WRITE_TIMEOUT)  # fmt: skip
         except (serial.SerialException, OSError, ValueError) as exc:
             raise PortError(f"{port}: cannot open the port ({exc})") from None
         self.port, self.timeout, self.retries = port, timeout, retries
         self.stats = LinkStats()
-        self.inbox: deque[Frame] = deque()  # device frames not yet taken by next_frame
+        self.inbox: deque[Frame] = deque()  # TELEMETRY, DONE and unasked ERRORs not yet taken
+        self.info: Info | None = None
         self._deframer = protocol.Deframer()
         self._seq = 0
         self._device_seq: int | None = None
-        self._expecting_info = False
+        self._waiting: tuple[int, Kind] | None = None  # the command awaiting its answer
+        self._answer: Frame | None = None
         try:
             self.info = self.handshake(expect)
         except Exception:
@@ -94,19 +141,16 @@ class Link:
         Returns:
             The device's handshake.
         """
-        self._expecting_info = True
-        try:
+        try:  # silence is bad input (a port without a rig); a device out of protocol is not
             info = protocol.decode_info(self._exchange(Kind.HELLO, b"", answer=Kind.INFO).body)
-        except DeviceError as exc:
+        except NoAnswerError as exc:
             raise PortError(str(exc)) from None
-        finally:
-            self._expecting_info = False
         if info.protocol != PROTOCOL_VERSION:
             raise PortError(f"{self.port}: the device speaks protocol {info.protocol}, "
-                              f"articula {PROTOCOL_VERSION}; update its firmware")  # fmt: skip
+                            f"articula {PROTOCOL_VERSION}; update its firmware")  # fmt: skip
         if expect is not None and info.rig != expect:
             raise PortError(f"{self.port}: a {info.rig.name.lower()} rig, not a "
-                              f"{expect.name.lower()} rig")  # fmt: skip
+                            f"{expect.name.lower()} rig")  # fmt: skip
         return info
 
     def command(self, kind: Kind, body: bytes = b"", fresh: bool = False) -> int:
@@ -126,20 +170,47 @@ class Link:
         self._exchange(kind, body, answer=Kind.ACK)
         return self._seq
 
-    def status(self) -> tuple[bool, int]:
+    def notify(self, kind: Kind, body: bytes = b"") -> None:
+        """Send one command once, without waiting for its answer (a STOP on the way out of a
+        failed run: the device's host timeout covers a loss).
+
+        Args:
+            kind: the command's message type.
+            body: the command's body.
+        """
+        self._seq = (self._seq + 1) & 0xFFFF
+        self._write(protocol.encode(kind, self._seq, body))
+
+    def status(self) -> Status:
         """Ask the device for its STATUS.
 
         Returns:
-            Whether a run is going on, and the samples of the current (else last) run so far.
+            Whether a run is going on, its samples so far, the device's receive losses and
+            how the last run ended.
         """
         reply = self._exchange(Kind.STATUS, b"", answer=Kind.ACK)
-        if len(reply.body) != 7:
-            raise DeviceError(f"{self.port}: a STATUS answer of {len(reply.body)} bytes")
-        running, samples = struct.unpack_from("<BI", reply.body, 2)
-        return bool(running), samples
+        if len(reply.body) != 10:
+            raise DeviceError(f"{self.port}: a STATUS answer of {len(reply.body)} bytes; "
+                              "the protocol's is 10")  # fmt: skip
+        running, samples, overruns, ended = struct.unpack_from("<BIHB", reply.body, 2)
+        if ended not in RunEnd._value2member_map_:
+            raise DeviceError(f"{self.port}: a STATUS answer with run end {ended}")
+        return Status(bool(running), samples, overruns, RunEnd(ended))
+
+    def setting(self, kind: Kind) -> bytes:
+        """The device's setting `kind` (a SET_ command) as that command carries it (GET).
+
+        Args:
+            kind: SET_GAINS, SET_REFERENCE, SET_OUTPUT or SET_DAMPING.
+
+        Returns:
+            The body the device holds for it.
+        """
+        return self._exchange(Kind.GET, bytes([kind]), answer=Kind.ACK).body[2:]
 
     def next_frame(self, timeout: float) -> Frame | None:
-        """The next device frame (TELEMETRY, DONE, ...) within `timeout`, else None.
+        """The next device frame (TELEMETRY, DONE, an ERROR nobody waits for) within
+        `timeout`, else None.
 
         Args:
             timeout: how long to wait for one [s].
@@ -167,74 +238,113 @@ class Link:
         """Send (kind, body) until `answer` naming it comes back; the answer frame."""
         seq = self._seq = (self._seq + 1) & 0xFFFF
         wire = protocol.encode(kind, seq, body)
-        for attempt in range(self.retries + 1):
-            if attempt:
-                self.stats.resends += 1
-            self._write(wire)
-            deadline = time.monotonic() + self.timeout
-            while time.monotonic() < deadline:
-                reply = self._take_reply(seq, answer)
-                if reply is not None:
-                    return reply
-                self._read()
-        raise DeviceError(f"{self.port}: no answer to {kind.name} after {self.retries + 1} "
-                          f"tries; is the rig on and running articula's firmware?")  # fmt: skip
+        self._waiting, self._answer = (seq, answer), None
+        try:
+            for attempt in range(self.retries + 1):
+                if attempt:
+                    self.stats.resends += 1
+                self._write(wire)
+                deadline = time.monotonic() + self.timeout
+                while self._answer is None and time.monotonic() < deadline:
+                    self._read()
+                if self._answer is not None:
+                    return self._answered()
+        finally:
+            self._waiting = None
+        raise NoAnswerError(f"{self.port}: no answer to {kind.name} after {self.retries + 1} "
+                            f"tries; is the rig on and running articula's firmware?")  # fmt: skip
 
-    def _take_reply(self, seq: int, answer: Kind) -> Frame | None:
-        """The inbox's answer to command `seq` (removed), if it is there; an ERROR naming it
-        raises DeviceError."""
-        for frame in list(self.inbox):
-            if frame.kind == answer and (answer == Kind.INFO or _acked(frame) == seq):
-                self.inbox.remove(frame)
-                return frame
-            if frame.kind == Kind.ERROR and _acked(frame) == seq:
-                self.inbox.remove(frame)
-                code, text = frame.body[2], frame.body[3:].decode("ascii", "replace")
-                raise DeviceError(f"{self.port}: the rig refused: {text} (code {code})")
-        return None
+    def _answered(self) -> Frame:
+        """The awaited answer; an ERROR naming the command raises DeviceError."""
+        frame = self._answer
+        if frame.kind == Kind.ERROR:
+            code, text = frame.body[2], frame.body[3:].decode("ascii", "replace")
+            raise DeviceError(f"{self.port}: the rig refused: {text} (code {code})")
+        return frame
 
     def _write(self, data: bytes) -> None:
         try:
             self.serial.write(data)
+        except serial.SerialTimeoutException:
+            raise DeviceError(f"{self.port}: the device took no bytes for {WRITE_TIMEOUT:g} s; "
+                              "it stopped reading the line") from None  # fmt: skip
         except (serial.SerialException, OSError) as exc:
             raise DeviceError(f"{self.port}: the line went down ({exc})") from None
 
     def _read(self) -> bool:
         """Read what the line has (waiting up to the port's timeout); True if a frame came."""
         try:
-            data = self.serial.read(max(1, self.serial.in_waiting))
+            data = self.serial.read(min(max(1, self.serial.in_waiting), 65536))
         except (serial.SerialException, OSError) as exc:
             raise DeviceError(f"{self.port}: the line went down ({exc})") from None
         got = False
+        discarded = self._deframer.discarded
         for raw in self._deframer.feed(data):
             try:
                 frame = protocol.decode(raw)
-            except DeviceError:
+            except FrameError:
                 self.stats.crc_errors += 1
                 continue
-            if self._count(frame):
-                self.inbox.append(frame)
-                got = True
+            except DeviceError as exc:
+                raise DeviceError(f"{self.port}: {exc}") from None
+            got |= self._route(frame)
+        self.stats.crc_errors += self._deframer.discarded - discarded
         return got
 
-    def _count(self, frame: Frame) -> bool:
-        """Track the device's sequence (gaps are losses); False for a frame to drop. An INFO
-        not asked for is a reset when it counts from 0 (a device that starts sends one),
-        else the late answer to a HELLO sent again."""
+    def _route(self, frame: Frame) -> bool:
+        """Count an intact frame and put it where it belongs: the awaited answer, the inbox,
+        or nowhere (a late answer to a command sent again); True if it is kept."""
+        self._check(frame)
         self.stats.frames += 1
         last, self._device_seq = self._device_seq, frame.seq
-        if frame.kind == Kind.INFO and not self._expecting_info:
-            if frame.seq == 0:
-                raise DeviceResetError(f"{self.port}: the device restarted (a reset or a "
-                                       "power loss)")  # fmt: skip
-            return False
+        waiting = self._waiting
+        if frame.kind == Kind.INFO:
+            if waiting is not None and waiting[1] == Kind.INFO:
+                self._answer = frame
+                return True
+            if frame.seq == 0:  # a device that starts counts from 0 and says so
+                cause = protocol.decode_info(frame.body).reset
+                raise DeviceResetError(f"{self.port}: the device restarted "
+                                       f"({RESET_WORDS[cause]})")  # fmt: skip
+            return False  # a late answer to a HELLO sent again
         if last is not None:
             self.stats.dropped += (frame.seq - last - 1) & 0xFFFF
+        answers = waiting is not None and (
+            (frame.kind == Kind.ACK and waiting[1] == Kind.ACK) or frame.kind == Kind.ERROR
+        )
+        if answers and _acked(frame) == waiting[0]:  # its ACK, or an ERROR naming it
+            self._answer = frame
+            return True
+        if frame.kind == Kind.ACK or self.info is None:
+            return False  # a late answer; or, before the handshake, an earlier session's
+        if len(self.inbox) >= MAX_INBOX:
+            raise DeviceError(f"{self.port}: more than {MAX_INBOX} frames came that nothing "
+                              "asked for; the device floods the line")  # fmt: skip
+        self.inbox.append(frame)
         return True
+
+    def _check(self, frame: Frame) -> None:
+        """DeviceError for an intact frame the protocol does not allow, naming what came."""
+        size = len(frame.body)
+        kind = Kind(frame.kind).name if frame.kind in Kind._value2member_map_ else None
+        if kind is None or frame.kind < 0x80:
+            what = kind or f"type 0x{frame.kind:02x}"
+            raise DeviceError(f"{self.port}: the device sent a frame of {what} ({size} "
+                              "bytes), which no device sends")  # fmt: skip
+        need = {Kind.ACK: (2, None), Kind.ERROR: (3, None), Kind.DONE: (6, 6)}.get(frame.kind)
+        if frame.kind == Kind.TELEMETRY and self.info is not None:
+            need = (4 + 4 * len(self.info.channels),) * 2
+        if need is not None and (size < need[0] or (need[1] is not None and size > need[1])):
+            exact = f"{need[0]}" if need[0] == need[1] else f"at least {need[0]}"
+            raise DeviceError(f"{self.port}: a {kind} frame of {size} bytes; the protocol's "
+                              f"has {exact} here")  # fmt: skip
+        if frame.kind == Kind.INFO:
+            try:
+                protocol.decode_info(frame.body)
+            except DeviceError as exc:
+                raise DeviceError(f"{self.port}: an INFO frame of {size} bytes: {exc}") from None
 
 
 def _acked(frame: Frame) -> int:
     """The command sequence number an ACK, ERROR or DONE names."""
-    if len(frame.body) < 2:
-        raise DeviceError(f"a {Kind(frame.kind).name} without the sequence number it answers")
     return int.from_bytes(frame.body[:2], "little")

@@ -24,7 +24,7 @@ from articula.rigs.firmware import Inputs, Pins
 from articula.rigs.programs import Program, Shape
 from articula.rigs.protocol import PROTOCOL_VERSION, Channel, Info, Kind, RigKind
 
-FIRMWARE = (0, 1, 0)
+FIRMWARE = (0, 2, 0)
 MEASURED = (Channel("i_ref", "A"), Channel("i_meas", "A"), Channel("i_fb", "A"),
             Channel("omega_meas", "rad/s"), Channel("v1", "V"), Channel("duty1", "counts"),
             Channel("v2", "V"))  # fmt: skip
@@ -114,6 +114,21 @@ class MotorDevice(PlayedRun):
         else:
             raise DeviceError(f"the motor rig does not take {Kind(kind).name}")
 
+    def setting(self, kind: int) -> bytes:
+        """SET_GAINS' or SET_REFERENCE's body as the device holds it.
+
+        Args:
+            kind: the SET_ command's message type.
+
+        Returns:
+            The body that command would carry.
+        """
+        if kind == Kind.SET_GAINS:
+            return self.gains.encode()
+        if kind == Kind.SET_REFERENCE:
+            return self.reference.encode()
+        raise DeviceError("this rig has no such setting")
+
     def start(self, duration: float, seed: int) -> None:
         """A run of `duration` from rest; the plant runs at the first sample (PlayedRun).
 
@@ -151,6 +166,7 @@ class MotorPins:
     """
 
     tick_us = None  # a control period per ADC conversion
+    program = "motor"  # firmware/src/motor.c
 
     def __init__(
         self,
@@ -165,7 +181,7 @@ class MotorPins:
         self.trace: list[tuple[float, float]] = []
         # The sensor's compiled code loads (or compiles) now, not while the firmware waits.
         self.start(0)
-        self.period(Pins(1, 0, 0, 0, 0, 0, 0, 0))
+        self.period(Pins(1, 0, 0, 0, 0, 0, 0, 0, 0))
         self.start(0)
 
     def start(self, seed: int) -> None:

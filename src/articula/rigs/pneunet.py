@@ -33,7 +33,7 @@ from articula.rigs.protocol import (
 from articula.rigs.run import run_program
 from articula.tuning.response import Response
 
-FIRMWARE = (0, 1, 0)
+FIRMWARE = (0, 2, 0)
 CHANNELS = (Channel("reference", "deg"), Channel("angle", "deg"), Channel("pwm", "counts"))
 SCHEDULES = ("constant", "piecewise", "fuzzy")
 
@@ -106,6 +106,24 @@ class PneuNetDevice:
         else:
             raise DeviceError(f"the PneuNet rig does not take {Kind(kind).name}")
 
+    def setting(self, kind: int) -> bytes:
+        """SET_GAINS', SET_REFERENCE's or SET_OUTPUT's body as the device holds it (the
+        output -1 when there is none).
+
+        Args:
+            kind: the SET_ command's message type.
+
+        Returns:
+            The body that command would carry.
+        """
+        if kind == Kind.SET_GAINS:
+            return encode_gains(self.schedule)
+        if kind == Kind.SET_REFERENCE:
+            return self.program.encode()
+        if kind == Kind.SET_OUTPUT:
+            return struct.pack("<Bf", 0, -1.0 if self.output is None else self.output)
+        raise DeviceError("this rig has no such setting")
+
     def start(self, duration: float, seed: int) -> None:
         """A run of `duration` from rest; sensor noise from seed as run_closed_loop draws
         it (the first of SeedSequence(seed)'s two streams).
@@ -130,6 +148,7 @@ class PneuNetDevice:
             is over.
         """
         if self._n >= self._steps:
+            self.output = None  # an open-loop output holds for one run, as on the firmware
             return None
         t = self._n * self.params.pwm_period
         measured = np.degrees(self._plant.read(self._noise[self._n : self._n + 1]))
@@ -200,6 +219,7 @@ class PneuNetPins:
     """
 
     tick_us = None  # a PWM period per ADC conversion
+    program = "pneunet"  # firmware/src/pneunet.c
 
     def __init__(self, params: PneuNetParams | None = None) -> None:
         self.params = params or PneuNetParams()

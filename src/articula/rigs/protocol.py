@@ -18,8 +18,9 @@ import numpy as np
 
 from articula.errors import DeviceError
 
-PROTOCOL_VERSION = 1
+PROTOCOL_VERSION = 2
 MAX_FRAME = 254  # bytes of header + body + CRC: one COBS block, a zero-free 255-byte frame
+MAX_KEPT = 4 * MAX_FRAME  # stuffed bytes of one frame kept to check it; longer: damaged
 HEADER = struct.Struct("<BH")  # type, sequence number
 CRC = struct.Struct("<H")
 
@@ -35,7 +36,8 @@ class Kind(IntEnum):
     SET_OUTPUT = 0x06  # channel u8, value float32: one actuator command held until STOP
     SET_DAMPING = 0x07  # delta, start [s], length [s] float32: the chapter-3 policy
     STREAM = 0x08  # decimation u16: one TELEMETRY frame every that many samples (0: none)
-    STATUS = 0x09  # () -> ACK with running u8 and the run's samples so far u32 after the seq
+    STATUS = 0x09  # () -> ACK: running u8, samples u32, rx_overruns u16, ended u8 after the seq
+    GET = 0x0A  # the type of a SET_ command u8 -> ACK: that setting's body after the seq
     INFO = 0x81  # the handshake (encode_info); also sent unasked after a reset
     ACK = 0x82  # acknowledged sequence number u16
     ERROR = 0x83  # sequence number u16, code u8, text (ASCII)
@@ -50,6 +52,26 @@ class ErrorCode(IntEnum):
     UNKNOWN = 2  # a message type this rig does not take
     BAD_VALUE = 3  # a value out of the rig's range
     BUSY = 4  # a command that needs the rig at rest, during a run
+    STOPPED = 5  # the device ended the run itself (the host's silence, an error): safe state
+
+
+class ResetCause(IntEnum):
+    """Why a device (re)started, as its INFO says (the ATmega2560's MCUSR)."""
+
+    POWER_ON = 0
+    EXTERNAL = 1  # its reset pin: the button, the USB bridge's DTR, the emulator's reset
+    WATCHDOG = 2  # its program stopped coming round its main loop
+    BROWN_OUT = 3  # its supply dropped
+
+
+class RunEnd(IntEnum):
+    """How the last run ended, as STATUS says."""
+
+    NOT_ENDED = 0  # running, or no run yet
+    DONE = 1  # its whole duration
+    STOP = 2  # the host's STOP
+    HOST_TIMEOUT = 3  # no frame from the host within host_timeout_ms
+    ERROR = 4  # the device's own error (a missed period, a silent sensor, the watchdog)
 
 
 class RigKind(IntEnum):
@@ -98,6 +120,7 @@ class Info:
         firmware: the firmware's version (major, minor, patch).
         sample_period_us: the device's sample period [µs].
         channels: the telemetry channels, in the order of TELEMETRY's values.
+        reset: why the device last started.
     """
 
     rig: RigKind
@@ -105,6 +128,12 @@ class Info:
     firmware: tuple[int, int, int]
     sample_period_us: int
     channels: tuple[Channel, ...]
+    reset: ResetCause = ResetCause.POWER_ON
+
+
+class FrameError(DeviceError):
+    """A frame damaged on the line (malformed COBS, CRC mismatch, too short): dropped and
+    counted, the sender resends or the next frame goes on."""
 
 
 def crc16(data: bytes) -> int:
@@ -158,7 +187,7 @@ def cobs_decode(data: bytes) -> bytes:
     while i < len(data):
         code = data[i]
         if code == 0 or i + code > len(data):
-            raise DeviceError("malformed COBS block")
+            raise FrameError("malformed COBS block")
         out += data[i + 1 : i + code]
         i += code
         if code < 0xFF and i < len(data):
@@ -185,7 +214,10 @@ def encode(kind: int, seq: int, body: bytes = b"") -> bytes:
 
 
 def decode(frame: bytes) -> Frame:
-    """One message from the bytes between two delimiters; DeviceError when it is damaged.
+    """One message from the bytes between two delimiters.
+
+    FrameError when it is damaged (malformed, too short, CRC mismatch); DeviceError when it
+    is intact but longer than the protocol's MAX_FRAME bytes (a sender out of protocol).
 
     Args:
         frame: the COBS-stuffed bytes between two delimiters.
@@ -195,19 +227,27 @@ def decode(frame: bytes) -> Frame:
     """
     payload = cobs_decode(frame)
     if len(payload) < HEADER.size + CRC.size:
-        raise DeviceError(f"a frame of {len(payload)} bytes is too short")
+        raise FrameError(f"a frame of {len(payload)} bytes is too short")
     (crc,) = CRC.unpack_from(payload, len(payload) - CRC.size)
     if crc16(payload[: -CRC.size]) != crc:
-        raise DeviceError("CRC mismatch")
+        raise FrameError("CRC mismatch")
     kind, seq = HEADER.unpack_from(payload)
+    if len(payload) > MAX_FRAME:
+        name = Kind(kind).name if kind in Kind._value2member_map_ else f"type 0x{kind:02x}"
+        raise DeviceError(f"a frame of {len(payload)} bytes ({name}), more than the "
+                          f"protocol's {MAX_FRAME}")  # fmt: skip
     return Frame(kind, seq, payload[HEADER.size : -CRC.size])
 
 
 class Deframer:
-    """Splits a byte stream into frames at the zero delimiters, across reads."""
+    """Splits a byte stream into frames at the zero delimiters, across reads, in bounded
+    memory: a frame longer than MAX_KEPT bytes is dropped whole and counted in `discarded`
+    (no valid frame is that long; its bytes are line noise or a sender out of protocol)."""
 
     def __init__(self) -> None:
         self._pending = bytearray()
+        self._skipping = False  # inside a frame already over MAX_KEPT: drop to its delimiter
+        self.discarded = 0
 
     def feed(self, data: bytes) -> list[bytes]:
         """The complete frames (delimiters removed, empty ones skipped) that `data` ends.
@@ -218,9 +258,21 @@ class Deframer:
         Returns:
             The frames completed, still COBS-stuffed (for `decode`), in order.
         """
-        self._pending += data
-        *frames, rest = bytes(self._pending).split(b"\0")
-        self._pending = bytearray(rest[-2 * MAX_FRAME :])  # garbage cannot grow without bound
+        *ends, rest = bytes(data).split(b"\0")
+        frames = []
+        for piece in ends:
+            if not self._skipping and len(self._pending) + len(piece) <= MAX_KEPT:
+                frames.append(bytes(self._pending + piece))
+            elif not self._skipping:
+                self.discarded += 1
+            self._pending.clear()
+            self._skipping = False
+        if not self._skipping and len(self._pending) + len(rest) > MAX_KEPT:
+            self._pending.clear()
+            self._skipping = True
+            self.discarded += 1
+        if not self._skipping:
+            self._pending += rest
         return [f for f in frames if f]
 
 
@@ -267,7 +319,7 @@ def encode_info(info: Info) -> bytes:
         for text in (channel.name, channel.unit):
             data = text.encode("ascii")
             out += struct.pack("<B", len(data)) + data
-    return out
+    return out + struct.pack("<B", info.reset)
 
 
 def decode_info(body: bytes) -> Info:
@@ -291,8 +343,11 @@ def decode_info(body: bytes) -> Info:
                 texts.append(body[at + 1 : at + 1 + size].decode("ascii"))
                 at += 1 + size
             channels.append(Channel(*texts))
-        if at != len(body):
-            raise ValueError(f"{len(body) - at} bytes after the last channel")
-        return Info(RigKind(rig), protocol, (major, minor, patch), period, tuple(channels))
+        if protocol != PROTOCOL_VERSION:  # the rest may differ: the version is what counts
+            return Info(RigKind(rig), protocol, (major, minor, patch), period, tuple(channels))
+        if at + 1 != len(body):
+            raise ValueError(f"{len(body) - at - 1} bytes after the reset cause")
+        reset = ResetCause(body[at])
+        return Info(RigKind(rig), protocol, (major, minor, patch), period, tuple(channels), reset)
     except (struct.error, IndexError, ValueError, UnicodeDecodeError) as exc:
         raise DeviceError(f"the handshake does not decode ({exc})") from None

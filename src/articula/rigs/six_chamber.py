@@ -24,7 +24,7 @@ from articula.rigs.firmware import Inputs, Pins
 from articula.rigs.programs import Program, Shape
 from articula.rigs.protocol import PROTOCOL_VERSION, Channel, Info, Kind, RigKind
 
-FIRMWARE = (0, 1, 0)
+FIRMWARE = (0, 2, 0)
 CHANNELS = (Channel("bend_x", "deg"), Channel("bend_y", "deg"))
 STEP = 1e-4  # [s] the plant's integration step (chapter 3's default)
 RECORD_EVERY = 10  # plant steps per kept sample (1 ms)
@@ -87,6 +87,21 @@ class SixChamberDevice(PlayedRun):
                 raise DeviceError(f"the six-chamber rig does not take {Kind(kind).name}")
         except (ConfigError, ValueError) as exc:
             raise DeviceError(f"{Kind(kind).name}: {exc}") from None
+
+    def setting(self, kind: int) -> bytes:
+        """SET_REFERENCE's (the actuation) or SET_DAMPING's body as the device holds it.
+
+        Args:
+            kind: the SET_ command's message type.
+
+        Returns:
+            The body that command would carry.
+        """
+        if kind == Kind.SET_REFERENCE:
+            return self.actuation.encode()
+        if kind == Kind.SET_DAMPING:
+            return encode_damping(self.damping)
+        raise DeviceError("this rig has no such setting")
 
     def start(self, duration: float, seed: int) -> None:
         """Fill, hold, vent and damp over `duration`; the sensor's noise from seed. The
@@ -176,6 +191,7 @@ class SixChamberPins:
     """
 
     tick_us = round(STEP * 1e6)
+    program = "six_chamber"  # firmware/src/six_chamber.c
 
     def __init__(
         self,
@@ -193,7 +209,7 @@ class SixChamberPins:
                               f"{self.sensor.rate:g} Hz)")  # fmt: skip
         # The model's compiled code loads (or compiles) now, not while the firmware waits.
         self.start(0)
-        self.period(Pins(255, 0, 0, 0, 0, 0, 0, 0))
+        self.period(Pins(255, 0, 0, 0, 0, 0, 0, 0, 0))
         self.start(0)
 
     def start(self, seed: int) -> None:

@@ -10,6 +10,7 @@ the rig sends it (an emulated rig); a real rig has only its sensor's (i_meas).
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -104,7 +105,10 @@ def run_on_rig(config: CurrentControlConfig, link: Link, recorder: Recorder) -> 
     names = [ch.name for ch in link.info.channels]
     t, rows = run_program(link, c.duration, c.seed, recorder.add)
     trace = dict(zip(names, rows.T, strict=True))
-    return {k: float(v[0]) for k, v in trace_metrics(c, t, trace).items()}
+    metrics = {k: float(v[0]) for k, v in trace_metrics(c, t, trace).items()}
+    if "i" not in trace:  # module docstring: not measurable on the sensor alone
+        metrics.update(current_rms_error=math.nan, noise_rms=math.nan)  # null in record.json
+    return metrics
 
 
 def trace_metrics(

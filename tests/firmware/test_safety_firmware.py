@@ -1,0 +1,157 @@
+"""The rigs' firmware is safe to leave connected (issue 27), proved on the emulated board with
+its output pins read from the harness's trace: a STOP at any phase of the control period
+leaves every output off by the time it is acknowledged; a host that goes silent stops the
+run within its timeout plus a period; a hung main loop is caught by the watchdog, which puts
+the outputs off and resets the board, and the host reports it; commands in bursts at 1 Mbaud
+during a run lose no byte. And the harness itself: its USART loses the bytes a late reader
+cannot take, as the chip's does (simavr's 64-byte FIFO would hide them)."""
+
+from __future__ import annotations
+
+import os
+import select
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from articula.book.ch4.experiment import CurrentControlConfig
+from articula.book.ch4.rig import firmware_motor
+from articula.rigs.firmware import FirmwareRig
+from articula.rigs.firmware_checks import (
+    WATCHDOG_S,
+    active_now,
+    host_loss_trial,
+    stop_trial,
+    traffic_trial,
+    watchdog_trial,
+)
+from articula.rigs.link import Link
+from articula.rigs.pin_trace import PinTrace
+from articula.rigs.pneunet import PneuNetPins
+from articula.rigs.six_chamber import SixChamberPins
+
+pytestmark = pytest.mark.firmware
+PLANTS = {"motor": lambda: firmware_motor(CurrentControlConfig()), "pneunet": PneuNetPins,
+          "six_chamber": SixChamberPins}  # fmt: skip
+RIGS = list(PLANTS)
+
+
+@pytest.fixture
+def traced(built, tmp_path):
+    """traced(name): build/<name>.elf on its plant with a pin trace, and a Link to it:
+    (rig, trace, link); closed after the test."""
+    opened = []
+
+    def run(name: str) -> tuple[FirmwareRig, PinTrace, Link]:
+        path = tmp_path / f"{name}.trace"
+        rig = FirmwareRig(built / f"{name}.elf", PLANTS[name](), trace=path)
+        link = Link(rig.path)
+        opened.append((rig, link))
+        return rig, PinTrace(path), link
+
+    yield run
+    for rig, link in opened:
+        link.close()
+        rig.close()
+
+
+@pytest.mark.parametrize(("name", "count"), [("motor", 40), ("pneunet", 12), ("six_chamber", 15)])
+def test_a_stop_at_any_phase_leaves_every_output_off_by_its_ack(traced, name, count):
+    rig, trace, link = traced(name)
+    assert active_now(rig, trace) == []  # at rest from start-up
+    rng = np.random.default_rng(27)
+    trials = [stop_trial(rig, trace, link, rng) for _ in range(count)]
+    assert [t for t in trials if t.failed] == []
+    # Stronger than "within a period of the ACK": the outputs are off before it goes out.
+    assert max(t.ack_to_safe_s for t in trials) < 0
+    phases = sorted(t.phase for t in trials)  # the STOPs came all over the period
+    assert phases[-1] - phases[0] > 0.5
+
+
+@pytest.mark.parametrize("name", RIGS)
+def test_a_silent_host_stops_the_run_within_its_timeout_and_a_period(traced, name):
+    rig, trace, link = traced(name)
+    period = link.info.sample_period_us * 1e-6
+    for timeout_ms in (100, 500):
+        trial = host_loss_trial(rig, trace, link, timeout_ms)
+        assert trial.said_why  # ERROR code 5 naming the START
+        # Not before the timeout (to the firmware clock's 1 ms), and within a period after it.
+        assert trial.timeout_s - 1e-3 < trial.latency_s <= trial.timeout_s + period
+        assert active_now(rig, trace) == []
+
+
+@pytest.mark.parametrize("name", ["motor", "pneunet"])
+def test_a_hung_main_loop_is_caught_by_the_watchdog_and_reported(traced, name):
+    rig, trace, link = traced(name)
+    reported, off_s = watchdog_trial(rig, trace, link)
+    assert reported  # DeviceResetError naming the watchdog; the board answers again
+    assert off_s <= WATCHDOG_S + 1e-3  # the watchdog's interrupt, before its reset
+
+
+def test_commands_in_bursts_during_a_run_lose_no_byte(traced):
+    rig, trace, link = traced("motor")
+    assert traffic_trial(rig, trace, link, bursts=30) == 0
+
+
+SLOW_READER = r"""
+#include <avr/io.h>
+#include <util/delay.h>
+/* Reads UDR0 by polling, 200 us after each byte, and echoes it, with 0xEE before it when
+ * DOR0 said bytes were lost before it. */
+int main(void) {
+    UCSR0A = _BV(U2X0);
+    UBRR0 = 1;
+    UCSR0B = _BV(RXEN0) | _BV(TXEN0);
+    for (;;) {
+        while (!(UCSR0A & _BV(RXC0))) {}
+        _delay_us(200);
+        uint8_t status = UCSR0A, byte = UDR0;
+        if (status & _BV(DOR0)) {
+            while (!(UCSR0A & _BV(UDRE0))) {}
+            UDR0 = 0xEE;
+        }
+        while (!(UCSR0A & _BV(UDRE0))) {}
+        UDR0 = byte;
+    }
+}
+"""
+
+
+def echoed(fd: int, sent: bytes, count: int) -> bytes:
+    """Write `sent` on the pty and read what comes back until `count` bytes (or 5 s)."""
+    os.write(fd, sent)
+    got = b""
+    deadline = time.monotonic() + 5
+    while len(got) < count and time.monotonic() < deadline:
+        if select.select([fd], [], [], 0.05)[0]:
+            got += os.read(fd, 256)
+    return got
+
+
+def test_the_harness_usart_loses_what_a_late_reader_cannot_take(built, tmp_path):
+    source = tmp_path / "slow.c"
+    source.write_text(SLOW_READER)
+    elf = tmp_path / "slow.elf"
+    subprocess.run(["avr-gcc", "-mmcu=atmega2560", "-DF_CPU=16000000UL", "-Os", "-o", elf,
+                    source], check=True)  # fmt: skip
+    trace = tmp_path / "slow.trace"
+    proc = subprocess.Popen([built / "harness", elf, "--trace", trace], stdout=subprocess.PIPE,
+                            text=True)  # fmt: skip
+    try:
+        path = next(line for line in proc.stdout if line.startswith("uart0 at ")).split()[-1]
+        fd = os.open(path, os.O_RDWR | os.O_NOCTTY)
+        # Three bytes back to back fit: two in the buffer, one in the shift register.
+        assert echoed(fd, b"\x01\x02\x03", 3) == b"\x01\x02\x03"
+        # Ten do not: the first two wait in the buffer, each of the next seven is lost when
+        # the next one's start bit finds it in the shift register, the last waits there.
+        back = echoed(fd, bytes(range(10, 20)), 4)
+        os.close(fd)
+    finally:
+        proc.kill()
+        proc.wait(10)
+    assert back == b"\xee\x0a\x0b\x13"  # DOR0 set at the first byte read after the losses
+    lines = Path(trace).read_text().splitlines()
+    assert len([line for line in lines if line.startswith("overrun")]) == 7
