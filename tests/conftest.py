@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import signal
 import subprocess
 import sys
 from collections.abc import Callable, Mapping
@@ -13,6 +14,13 @@ from typing import Any
 
 import pytest
 import tomli_w
+
+# A shell without job control starts a background job with SIGINT ignored, and a process
+# inherits that: the Ctrl-C tests' commands would then never see their SIGINT. Handle it here,
+# so that every command the tests start begins with SIGINT at its default (exec resets a
+# handler, not an ignored signal).
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 # The console script installed beside the interpreter running the tests (the venv's).
 _SCRIPT = Path(sys.executable).with_name("articula")
