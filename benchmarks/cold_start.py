@@ -37,24 +37,21 @@ def child(method: str, steps: int) -> None:
     """One fresh process: import, build, reset and step; prints its times as JSON."""
     started = time.perf_counter()
     from articula.book.study import packaged
+    from articula.experiments.plan import build_plan
     from articula.loops.online import OnlineController
-    from articula.planning.config import PlannerSpec, TrajectorySpec, make_targets
-    from articula.scene.config import build_scene, load_scene_spec
     from articula.validation import load_toml
 
     import_ms = 1e3 * (time.perf_counter() - started)
     path = packaged("ch1", "circle_two_obstacles.toml")
-    data = load_toml(path)
-    scene, q0 = build_scene(load_scene_spec(data), path.parent)
-    spec = PlannerSpec(**{**data["planner"], "method": method})
-    targets = make_targets(TrajectorySpec(**data["trajectory"]), path.parent)
-    controller = OnlineController.from_spec(scene, spec, seed=0)
+    plan = build_plan(load_toml(path), path.parent, str(path))
+    dt = plan.spec.dt
+    controller = OnlineController(plan.planner(method), dt)
     start = time.perf_counter()
-    controller.reset(q0)
+    controller.reset(plan.q0)
     reset_ms = 1e3 * (time.perf_counter() - start)
     times = []
     for k in range(steps + 1):
-        target = targets(k * spec.dt)
+        target = plan.reference(k * dt)
         start = time.perf_counter()
         controller.step(target)
         times.append(1e3 * (time.perf_counter() - start))

@@ -56,10 +56,10 @@ import numpy as np
 from common import run
 
 from articula.book.study import packaged
+from articula.experiments.plan import build_plan
 from articula.geometry.shapes import convex_hull
 from articula.loops.online import OnlineController
-from articula.planning.config import PlannerSpec, TrajectorySpec, make_targets
-from articula.scene.config import build_scene, load_scene_spec
+from articula.planning.config import PlannerSpec
 from articula.scene.obstacles import Obstacle
 from articula.scene.scene import Scene
 from articula.validation import load_toml
@@ -94,15 +94,15 @@ def measure(steps: int) -> dict[str, Any]:
 
     path = packaged("ch1", SCENE)
     data = load_toml(path)
-    scene, q0 = build_scene(load_scene_spec(data), path.parent)
     table = {**data["planner"], "limits": "velocity", "influence": INFLUENCE}
+    plan = build_plan({**data, "planner": table}, path.parent, str(path))
+    scene, q0, targets = plan.scene, plan.q0, plan.targets
     specs = {
         "qp": PlannerSpec(**{**table, "method": "qp"}),
         "improved": PlannerSpec(**{**table, "method": "baornn-improved"}),
     }
     d_min, dt = specs["qp"].d_min, specs["qp"].dt
-    seed = int(table.get("seed", 0))
-    targets = make_targets(TrajectorySpec(**data["trajectory"]), path.parent)
+    seed = plan.config.seed
     reference = np.array([targets(n * dt).position for n in range(max(steps, FAR_STEPS))])
     # A damper like the qp's (1 m/s over the detection band) in mink's units.
     gain = matched_gain(dt, d_min, INFLUENCE)

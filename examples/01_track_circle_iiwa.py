@@ -20,12 +20,9 @@ from pathlib import Path
 
 from matplotlib.figure import Figure
 
+from articula.experiments.plan import build_plan
 from articula.loops.tracking import track, tracking_metrics
-from articula.planning.approach import approach
-from articula.planning.config import PlannerSpec, TrajectorySpec, make_planner, make_targets
-from articula.planning.task import Target
-from articula.scene.config import build_scene, load_scene_spec
-from articula.validation import load_toml, parse_model
+from articula.validation import load_toml
 
 SCENE_FILE = Path(str(resources.files("articula") / "book/ch1/configs/circle_two_obstacles.toml"))
 ROW = "{:<16}{:>15}{:>15}{:>15}{:>13}"  # the printed table's columns
@@ -39,24 +36,19 @@ def main():
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
 
-    config = load_toml(SCENE_FILE)  # [robot], [[obstacles]], [trajectory], [planner]
-    scene, q0 = build_scene(load_scene_spec(config, str(SCENE_FILE)), SCENE_FILE.parent)
-    targets = make_targets(parse_model(TrajectorySpec, config["trajectory"]), SCENE_FILE.parent)
-    book = parse_model(PlannerSpec, config["planner"], str(SCENE_FILE))
+    # [robot], [[obstacles]], [trajectory], [planner]: the scene, its start q0, the circle and
+    # the reference that first moves from the tool at home to the circle's start (the approach).
+    plan = build_plan(load_toml(SCENE_FILE), SCENE_FILE.parent, str(SCENE_FILE))
+    scene, q0, reference, book = plan.scene, plan.q0, plan.reference, plan.spec
     duration = 8.0 if args.quick else book.duration  # [s]; one lap takes 50 s
     settle = min(book.settle, duration / 2)  # [s] into the circle
-    # From the tool at home to the circle's start, at most 0.25 m/s, then the circle.
-    home = scene.robot.ee_pose(q0)
-    reference = approach(targets, Target(home[:3, 3], home[:3, :3]), book.approach_speed,
-                         book.approach_turn_rate)  # fmt: skip
     lead = reference.duration  # [s]
 
     runs = {}
     print(ROW.format("method", "RMS error [mm]", "max error [mm]", "clearance [mm]", "period [µs]"))
     for method in METHODS:
-        spec = book.model_copy(update={"method": method})
-        planner = make_planner(spec, scene, seed=0)
-        run = track(planner, reference, q0, spec.dt, lead + duration, path_start=lead)
+        planner = plan.planner(method)
+        run = track(planner, reference, q0, book.dt, lead + duration, path_start=lead)
         m = tracking_metrics(run, scene.robot, settle, planner.iterations)
         mm = [f"{1e3 * m[k]:.3f}" for k in ("rms_error", "max_error", "min_clearance")]
         print(ROW.format(method, *mm, f"{m['time_per_period_us']:.0f}"))

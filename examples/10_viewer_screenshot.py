@@ -27,7 +27,7 @@ from pathlib import Path
 from PIL import Image
 from playwright.sync_api import sync_playwright
 
-from articula.book.ch1.experiment import load_plan
+from articula.experiments.plan import load_plan
 from articula.runs.runner import run_to_folder
 
 SCENE_FILE = Path(str(resources.files("articula") / "book/ch1/configs/circle_two_obstacles.toml"))

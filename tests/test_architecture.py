@@ -30,6 +30,7 @@ LAYERS = {
     "loops": 8,
     "runs": 9,
     "rigs": 10,
+    "experiments": 10,
     "book": 11,
     "bench": 11,
     "viewer": 11,
@@ -118,3 +119,47 @@ def test_every_top_level_package_has_a_layer():
 def test_no_source_module_is_over_the_line_limit(module):
     lines = MODULES[module].read_text(encoding="utf-8").count("\n")
     assert lines <= MAX_LINES, f"{module}: {lines} lines"
+
+
+# A plan is assembled once, by articula.experiments.plan.build_plan: a scene built from a
+# config together with a planner or an online controller made for it. Any other module (or
+# benchmark or example) that does both is a second assembly, which would drift from the first
+# (its errors naming other keys, its defaults other values).
+BUILDERS = {"build_scene", "load_scene_spec"}
+PLANNERS = {"make_planner", "from_spec"}
+ASSEMBLY = "articula.experiments.plan"
+ROOT = SRC.parent
+
+
+def _called(path: Path) -> set[str]:
+    """Names of the functions and methods `path` calls."""
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Call):
+            func = node.func
+            names.add(func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", ""))
+    return names
+
+
+def _scripts() -> Iterator[tuple[str, Path]]:
+    """Every module of articula, every benchmark and every example."""
+    yield from MODULES.items()
+    for folder in ("benchmarks", "examples"):
+        for path in sorted((ROOT / folder).glob("*.py")):
+            yield f"{folder}/{path.name}", path
+
+
+@pytest.mark.parametrize(("name", "path"), list(_scripts()), ids=lambda v: str(v))
+def test_a_plan_is_assembled_only_by_build_plan(name, path):
+    calls = _called(path)
+    if name != ASSEMBLY and calls & BUILDERS:
+        assert not calls & PLANNERS, f"{name} builds a scene and a planner: use build_plan"
+
+
+def test_the_assembly_check_finds_a_second_assembly(tmp_path):
+    second = tmp_path / "second.py"
+    second.write_text(
+        "scene, q0 = build_scene(load_scene_spec(data), folder)\n"
+        "controller = OnlineController.from_spec(scene, spec)\n"
+    )
+    assert _called(second) & BUILDERS and _called(second) & PLANNERS

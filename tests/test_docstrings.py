@@ -29,7 +29,6 @@ EXCLUDED_PACKAGES = ("articula.book", "articula.cli")
 # The chapter homes' experiments (their configs and run functions), the book's values and
 # chapter 2's tuning study: the examples and guides call them, so they are API too.
 BOOK_API = (
-    "articula.book.ch1.experiment",
     "articula.book.ch2.book_values",
     "articula.book.ch2.experiment",
     "articula.book.ch2.tuning",

@@ -85,7 +85,7 @@ PRELOAD = (
     "articula.runs.sweep",
     "articula.runs.records",
     "articula.scene.check",
-    "articula.book.ch1.experiment",
+    "articula.experiments.plan",
     "articula.book.ch2.experiment",
     "articula.book.ch3.experiment",
     "articula.book.ch4.experiment",

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from articula.book.ch1.experiment import PlanConfig, load_plan, run_plan
+from articula.experiments.plan import PlanConfig, load_plan, run_plan
 from articula.runs.registry import Result
 from articula.scene.config import build_scene
 from articula.validation import parse_model

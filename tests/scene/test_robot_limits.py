@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from articula.book.ch1.experiment import PlanConfig, run_plan
 from articula.errors import ConfigError, InfeasibleError
+from articula.experiments.plan import PlanConfig, run_plan
 from articula.loops.online import OnlineController
 from articula.planning.config import PlannerSpec
 from articula.scene.config import build_scene, load_scene_spec

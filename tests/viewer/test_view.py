@@ -4,6 +4,7 @@ and taken ports are one line, exit 2."""
 
 from __future__ import annotations
 
+import shutil
 import signal
 import socket
 import urllib.request
@@ -65,3 +66,27 @@ def test_a_taken_port_is_one_line_and_exit_2(planned_run, cli):
     assert proc.returncode == 2
     assert len(proc.stderr.strip().splitlines()) == 1 and "--port" in proc.stderr
     assert np.isfinite(port)
+
+
+def test_plan_live_and_view_name_a_bad_key_alike(planned_run, cli, tmp_path):
+    """One assembly (experiments.plan.build_plan): the same line, file and key, from each."""
+    scene = tmp_path / "scene.toml"
+    scene.write_text(
+        (planned_run / "config.toml").read_text().replace("radius = 0.2", "radius = -0.2")
+    )
+    assert "radius = -0.2" in scene.read_text()
+    run = tmp_path / "run"
+    shutil.copytree(planned_run, run)
+    shutil.copy(scene, run / "config.toml")
+    plan = cli("plan", scene, "--out", tmp_path / "out")
+    live = cli("live", scene, "--port", str(free_port()))
+    assert plan.returncode == live.returncode == 2
+    assert (
+        plan.stderr
+        == live.stderr
+        == f"error: {scene}: trajectory.radius: Input should be greater than 0 (got -0.2)\n"
+    )
+    view = cli("view", run, "--port", str(free_port()))
+    again = cli("plan", run / "config.toml", "--out", tmp_path / "out2")
+    assert view.returncode == again.returncode == 2 and view.stderr == again.stderr
+    assert f"{run / 'config.toml'}: trajectory.radius" in view.stderr

@@ -31,11 +31,13 @@ import trimesh
 from scipy.spatial.transform import Rotation
 
 from articula.errors import InfeasibleError
+from articula.experiments.plan import NAME as PLAN
 from articula.geometry.poses import pose
 from articula.geometry.shapes import ConvexShape, box, capsule, convex_hull, sphere
 from articula.loops.tracking import track, tracking_metrics
-from articula.planning.config import PlannerSpec, TrajectorySpec, make_planner, make_targets
+from articula.planning.config import TrajectorySpec, make_targets
 from articula.planning.target_path import TargetPath
+from articula.planning.velocity_ik import VelocityIk
 from articula.robots.model import RobotModel
 from articula.scene.config import build_scene, load_scene_spec
 from articula.scene.obstacles import Obstacle
@@ -110,7 +112,7 @@ def generate(robot_table: dict[str, Any], seed: int, index: int) -> Problem:
             continue
         planner = {**PLANNER, "duration": duration, "seed": seed}
         robot_out = {k: v for k, v in robot_table.items() if k != "q0"} | {"q0": q0.tolist()}
-        config = {"experiment": "baornn.plan", "robot": robot_out, "obstacles": obstacles,
+        config = {"experiment": PLAN, "robot": robot_out, "obstacles": obstacles,
                   "trajectory": trajectory, "planner": planner}  # fmt: skip
         return Problem(config, meshes, kind)
     raise InfeasibleError(
@@ -161,7 +163,7 @@ def _reachable(
 ) -> np.ndarray | None:
     """The joint motion [rad] (periods × nq) of obstacle-free DLS along the path, or None when
     it does not track within REACH_RMS."""
-    planner = make_planner(PlannerSpec(method="dls", dt=DT), Scene(robot, []), 0)
+    planner = VelocityIk(Scene(robot, []), "dls", DT)
     run = track(planner, targets, q0, DT, duration, 10**6)
     metrics = tracking_metrics(run, robot, SETTLE, planner.iterations)
     if metrics["rms_error"] > REACH_RMS or metrics["joint_limit_violations"] > 0:

@@ -31,15 +31,13 @@ import tomli_w
 
 from articula.bench.problems import D_MIN, DT, INFLUENCE, SETTLE, generate
 from articula.errors import ArticulaError
-from articula.loops.online import OnlineController
-from articula.planning.config import PlannerSpec, TrajectorySpec, make_targets
+from articula.experiments.plan import PlanSetup, build_plan
+from articula.planning.config import METHODS
 from articula.runs import records
 from articula.runs.backends import check_backend, execute_all
 from articula.runs.folders import RESULTS, SUMMARY, claimed
-from articula.scene.config import build_scene, load_scene_spec
-from articula.scene.scene import Scene
 
-ARTICULA_METHODS = ("baornn", "baornn-improved", "pinv", "dls", "qp")
+ARTICULA_METHODS = METHODS
 PEER_METHODS = ("mink", "mink-matched")
 FAILURES = ("error", "collision", "joint_limits", "speed_limits", "tracking")
 SUCCESS_RMS = 0.001  # [m] after SETTLE
@@ -144,27 +142,25 @@ def solve_problem(task: Mapping[str, Any]) -> tuple[int, list[dict[str, Any]]]:
         records.atomic_write(folder / name, mesh.export(file_type="stl"))
     records.atomic_write(folder / "scene.toml", tomli_w.dumps(problem.config).encode())
     config = problem.config
-    scene, q0 = build_scene(load_scene_spec(config), folder)
-    targets = make_targets(TrajectorySpec(**config["trajectory"]), folder)
+    plan = build_plan(config, folder, str(folder / "scene.toml"))
     steps = round(config["planner"]["duration"] / DT)
-    targets_per_step = [targets(n * DT) for n in range(steps)]
+    targets_per_step = [plan.targets(n * DT) for n in range(steps)]
     rows = []
     for method in task["methods"]:
         row = {"problem": task["index"], "method": method, "path": problem.path_kind,
                "obstacles": len(config["obstacles"])}  # fmt: skip
-        rows.append(row | _run(method, scene, q0, config["planner"], targets_per_step))
+        rows.append(row | _run(method, plan, targets_per_step))
     saved = {"key": task["key"], "rows": rows}
     records.atomic_write(folder / "results.json", json.dumps(saved).encode())
     return task["index"], rows
 
 
-def _run(
-    method: str, scene: Scene, q0: np.ndarray, planner: Mapping[str, Any], targets: list
-) -> dict[str, Any]:
+def _run(method: str, plan: PlanSetup, targets: list) -> dict[str, Any]:
     """One method on one problem: its success, failure class, metrics and step times."""
+    scene, q0 = plan.scene, plan.q0
     robot = scene.robot
     try:
-        step = _controller(method, scene, q0, planner)
+        step = _controller(method, plan)
         qs = np.empty((len(targets), robot.nq))
         times = np.empty(len(targets), dtype=np.int64)
         for n, target in enumerate(targets):
@@ -202,21 +198,16 @@ def _run(
             "step_us": step_us}  # fmt: skip
 
 
-def _controller(
-    method: str, scene: Scene, q0: np.ndarray, planner: Mapping[str, Any]
-) -> Callable[[Any], np.ndarray]:
-    """A step function (target -> q [rad]) of `method` reset to q0."""
+def _controller(method: str, plan: PlanSetup) -> Callable[[Any], np.ndarray]:
+    """A step function (target -> q [rad]) of `method` reset to the plan's q0."""
     if method in PEER_METHODS:
         from articula.bench.mink_peer import MinkArm, matched_gain  # the peers extra
 
         gain = matched_gain(DT, D_MIN, INFLUENCE) if method == "mink-matched" else 0.85
-        arm = MinkArm(scene, D_MIN, INFLUENCE, DT, gain=gain)
-        arm.reset(q0)
+        arm = MinkArm(plan.scene, D_MIN, INFLUENCE, DT, gain=gain)
+        arm.reset(plan.q0)
         return lambda target: arm.step(target.position)
-    spec = PlannerSpec(**{**planner, "method": method})
-    controller = OnlineController.from_spec(scene, spec, seed=int(planner.get("seed", 0)))
-    controller.reset(q0)
-    return controller.step
+    return plan.controller(method).step
 
 
 def summarize(

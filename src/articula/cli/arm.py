@@ -41,7 +41,7 @@ def plan(
     \b
     Example: articula plan src/articula/book/ch1/configs/circle_two_obstacles.toml --out runs/circle
     """
-    from articula.book.ch1.experiment import load_plan
+    from articula.experiments.plan import load_plan
     from articula.runs.runner import run_to_folder
 
     with progress_bar(as_json) as bar:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, get_args
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -43,6 +43,7 @@ from articula.validation import (
 )
 
 Method = Literal["baornn", "baornn-improved", "pinv", "dls", "qp"]
+METHODS: tuple[str, ...] = get_args(Method)  # every planning method, by its [planner] name
 Limits = Literal["velocity+acceleration", "velocity", "none"]
 Rpy = Annotated[list[Radians], Field(min_length=3, max_length=3)]
 Quaternion = Annotated[list[Finite], Field(min_length=4, max_length=4)]

@@ -19,25 +19,24 @@ import numpy as np
 import viser
 
 from articula.errors import ArticulaError
+from articula.experiments.plan import NAME as PLAN
+from articula.experiments.plan import build_plan
 from articula.loops.online import OnlineController
 from articula.loops.tracking import PlanResult, trace_columns, tracking_metrics
+from articula.planning.approach import Approach
 from articula.planning.config import (
+    METHODS,
     PlannerSpec,
-    TrajectorySpec,
     absolute_paths,
-    make_targets,
 )
-from articula.planning.target_path import TargetPath
 from articula.runs.records import build_record, write_run
 from articula.runs.registry import Result
-from articula.scene.config import build_scene, load_scene_spec
 from articula.scene.scene import Scene
-from articula.validation import fields_as, load_toml
+from articula.validation import load_toml
 from articula.viewer import drawing
 from articula.viewer.painter import Painter
-from articula.viewer.run_data import PLAN, TRACK, visuals_of
+from articula.viewer.run_data import TRACK, visuals_of
 
-METHODS = ("baornn", "baornn-improved", "pinv", "dls", "qp")
 READOUT_EVERY = 9  # periods between readouts (~10 a second, what a person reads); a
 # multiple of DRAW_EVERY, as a readout goes out with a picture
 DRAW_EVERY = 3  # periods between pictures: 33 Hz at 10 ms, smooth to the eye (each is
@@ -75,13 +74,14 @@ class LiveScene:
         config: the scene file as a plan config (its paths absolute).
         scene: the robot and obstacles.
         q0: the start configuration, shape (n,) [rad].
-        targets: the end-effector's path (t [s] -> target).
+        targets: the end-effector's reference (t [s] -> target): the approach from the tool
+            to the path's start, then the path.
     """
 
     config: dict[str, Any]
     scene: Scene
     q0: np.ndarray
-    targets: TargetPath
+    targets: Approach
 
     @classmethod
     def load(cls, scene_file: Path, method: str | None = None) -> LiveScene:
@@ -98,15 +98,9 @@ class LiveScene:
         config = _plan_config(scene_file)
         if method is not None:
             config["planner"]["method"] = method
-        scene, q0 = build_scene(load_scene_spec(config), scene_file.parent)
-        targets = make_targets(TrajectorySpec(**config["trajectory"]), scene_file.parent)
-        spec = PlannerSpec(**config["planner"])
-        controller = OnlineController.from_spec(
-            scene, spec, int(spec.seed or 0), live_obstacles=True
-        )
-        with fields_as({"q0": f"{scene_file}: robot.q0"}):  # as `plan` names it
-            controller.reset(q0)
-        return cls(config, scene, q0, targets)
+        plan = build_plan(config, scene_file.parent, str(scene_file))  # named as `plan` does
+        plan.controller(live_obstacles=True)  # a start it refuses is refused here
+        return cls(config, plan.scene, plan.q0, plan.reference)
 
 
 class Live:

@@ -13,14 +13,14 @@ import trimesh
 from scipy.spatial.transform import Rotation
 
 from articula.errors import ArticulaError, ConfigError
+from articula.experiments.plan import NAME as PLAN
+from articula.experiments.plan import build_plan
 from articula.robots.model import BUILTIN
 from articula.robots.urdf_visuals import Visual, visual_meshes
 from articula.runs.folders import CONFIG, TRACE
-from articula.scene.config import build_scene, load_scene_spec
 from articula.scene.obstacles import Obstacle
 from articula.scene.scene import Scene
 
-PLAN = "baornn.plan"
 TRACK = ("x", "y", "z", "qw", "qx", "qy", "qz")  # a live run's obstacle pose columns
 
 
@@ -212,7 +212,7 @@ def load_run(folder: Path) -> RunData:
         trace = pq.read_table(folder / TRACE).to_pydict()
     except (OSError, ValueError) as exc:
         raise RunFolderError("RUN_DIR", f"{folder} has no readable {TRACE} ({exc})") from None
-    scene, _ = build_scene(load_scene_spec(config), folder)
+    scene = build_plan(config, folder, str(folder / CONFIG)).scene  # errors named as `plan`
     nq = scene.robot.nq
     column = lambda *names: np.column_stack([trace[n] for n in names])  # noqa: E731
     return RunData(

@@ -8,9 +8,9 @@ from typing import Any
 
 import pytest
 
-from articula.book.ch1 import experiment
-from articula.book.ch1.experiment import PlanConfig, absolute_paths, load_plan, run_plan
 from articula.errors import ConfigError, InfeasibleError
+from articula.experiments import plan as experiment
+from articula.experiments.plan import PlanConfig, absolute_paths, load_plan, run_plan
 from articula.planning.config import PlannerSpec
 from articula.runs.registry import parse_config
 from articula.runs.runner import execute

@@ -20,8 +20,8 @@ from articula.book.ch1.book_values import (
     Run,
     slug,
 )
-from articula.book.ch1.experiment import NAME
 from articula.book.study import Study, packaged, read_metrics, read_trace
+from articula.experiments.plan import NAME
 from articula.planning.config import PlannerSpec
 from articula.runs.records import atomic_write
 from articula.scene.config import PACKAGE_URI, build_scene, load_scene_spec

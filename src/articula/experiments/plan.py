@@ -1,0 +1,246 @@
+"""The planning experiment `baornn.plan`, and the one function that turns a plan config into a
+ready scene, reference path and controller.
+
+A plan config is a scene file ([robot], [[obstacles]]) with a [trajectory] and a [planner]
+table, and optionally `experiment = "baornn.plan"` and a top-level `seed`. `articula plan
+SCENE.toml` and `articula run CONFIG.toml` both run it through the shared runner, so a plan
+folder's config.toml re-runs and sweeps like any other experiment's. `build_plan` is how every
+entry (plan, run, live, view, the bench suite, the peers benchmark, the examples) assembles
+one, so that all of them read a file alike and name its keys alike in their errors.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pydantic import model_validator
+
+from articula.errors import ConfigError, InfeasibleError
+from articula.loops.online import OnlineController
+from articula.loops.tracking import trace_columns, track, tracking_metrics
+from articula.planning.approach import Approach, approach
+from articula.planning.config import (
+    PlannerSpec,
+    TrajectorySpec,
+    absolute_paths,
+    make_planner,
+    make_targets,
+)
+from articula.planning.planner import Planner
+from articula.planning.reach import check_reach
+from articula.planning.target_path import TargetPath
+from articula.planning.task import Target
+from articula.runs.registry import Experiment, Progress, Result
+from articula.runs.runner import named_by_file
+from articula.scene.config import SceneSpec, build_scene
+from articula.scene.scene import Scene
+from articula.validation import Seed, fields_as, load_toml, parse_model
+
+NAME = "baornn.plan"
+# Library argument names -> where the user wrote them in a plan config.
+_CONFIG_PATHS = {"q0": "robot.q0", "dt": "planner.dt", "duration": "planner.duration"}
+
+
+class PlanConfig(SceneSpec):
+    """A scene with the path to track and the planner that tracks it.
+
+    `seed` seeds the planner's randomness; when absent, `planner.seed` (the form of scene
+    files), else 0. The validated config holds it once, at the top.
+
+    Attributes:
+        robot: the [robot] table: the URDF, its start configuration q0 and its options.
+        obstacles: the [[obstacles]] tables, in file order.
+        seed: seed of the planner's randomness; after validation never None (`planner.seed`
+            or 0 when absent).
+        trajectory: the [trajectory] table: the path to track (circle of Eq. 1.27,
+            rectangle, waypoints or CSV) and optionally the tool's orientation or axis.
+        planner: the [planner] table: the method, its parameters, the control period and
+            the run's duration.
+    """
+
+    seed: Seed | None = None
+    trajectory: TrajectorySpec
+    planner: PlannerSpec = PlannerSpec()
+
+    @model_validator(mode="after")
+    def _one_seed(self) -> PlanConfig:
+        seed = self.seed if self.seed is not None else self.planner.seed
+        object.__setattr__(self, "seed", 0 if seed is None else seed)
+        object.__setattr__(self, "planner", self.planner.model_copy(update={"seed": None}))
+        return self
+
+
+@dataclass(frozen=True)
+class PlanSetup:
+    """A plan config made ready: its scene, start, path and planner settings.
+
+    Attributes:
+        config: the validated config.
+        scene: the robot, its obstacles and its checked link pairs.
+        q0: the start, shape (n,) [rad].
+        targets: the path's targets over its own time [s].
+        reference: the targets over the run's time: the approach from the tool at q0 to the
+            path's start (`planner.approach = "auto"`), then the path.
+        where: the config's file (or a name for it), which errors name.
+    """
+
+    config: PlanConfig
+    scene: Scene
+    q0: np.ndarray
+    targets: TargetPath
+    reference: Approach
+    where: str
+
+    @property
+    def spec(self) -> PlannerSpec:
+        """The [planner] table."""
+        return self.config.planner
+
+    def planner(self, method: str | None = None) -> Planner:
+        """The config's planner (or `method` with the config's other settings).
+
+        Args:
+            method: a method name to use instead of `planner.method`; None: the config's.
+
+        Returns:
+            The planner, seeded with the config's seed.
+        """
+        spec = self.spec if method is None else _with_method(self.spec, method, self.where)
+        with named_by_file(self.where), fields_as(_CONFIG_PATHS):
+            return make_planner(spec, self.scene, self.config.seed)
+
+    def controller(
+        self, method: str | None = None, live_obstacles: bool = False
+    ) -> OnlineController:
+        """An online controller of the config's planner, reset at q0 (kernels compiled).
+
+        Args:
+            method: a method name to use instead of `planner.method`; None: the config's.
+            live_obstacles: let step() move every obstacle of the scene.
+
+        Returns:
+            The controller, ready for its first step().
+        """
+        spec = self.spec if method is None else _with_method(self.spec, method, self.where)
+        with named_by_file(self.where), fields_as(_CONFIG_PATHS):
+            controller = OnlineController.from_spec(
+                self.scene, spec, self.config.seed, live_obstacles=live_obstacles
+            )
+            controller.reset(self.q0)
+        return controller
+
+
+def build_plan(
+    config: PlanConfig | Mapping[str, Any], base_dir: Path, where: str = ""
+) -> PlanSetup:
+    """The one assembly of a plan config: validated (errors name `where` and the TOML key),
+    its scene, start, targets and reference with the approach.
+
+    Args:
+        config: the validated config, or its tables as read from TOML.
+        base_dir: folder relative paths are taken from (the config file's).
+        where: the config's file, prefixed to the key in errors.
+
+    Returns:
+        The plan, ready to plan or to run online.
+    """
+    if not isinstance(config, PlanConfig):
+        body = {k: v for k, v in config.items() if k != "experiment"}
+        config = parse_model(PlanConfig, body, where)
+    p = config.planner
+    with named_by_file(where):
+        scene, q0 = build_scene(config, base_dir)
+        targets = make_targets(config.trajectory, base_dir)
+    pose = scene.robot.ee_pose(q0)
+    axis = pose[:3, :3] @ np.asarray(p.tool_axis, dtype=float)
+    tool = Target(pose[:3, 3].copy(), pose[:3, :3].copy(), axis / np.linalg.norm(axis))
+    if p.approach == "auto":
+        reference = approach(targets, tool, p.approach_speed, p.approach_turn_rate)
+    else:
+        reference = Approach(targets, tool, 0.0)  # the path at once, as in the book
+    return PlanSetup(config, scene, q0, targets, reference, where)
+
+
+def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
+    """Track the path; metrics of loops.tracking.tracking_metrics and its trace columns.
+
+    Relative file paths start at the working folder (a config read from a file has them made
+    absolute by `absolute_paths`).
+
+    Args:
+        config: the validated plan config.
+        progress: called as progress(done, total) every hundredth of the run; None: silent.
+
+    Returns:
+        The metrics of tracking_metrics (rms_error and max_error after `planner.settle` into
+            the path [m], clearances [m], collisions, limits, planner timings) and the trace
+            columns of trace_columns (t [s], phase, q_1..q_m [rad], x, y, z, their
+            references x_ref, y_ref, z_ref, error and clearance [m]).
+
+    Raises:
+        InfeasibleError: the path is out of the robot's reach, or its rms_error after
+            `planner.settle` exceeds `planner.tolerance` (or, for a pose or axis task, its
+            rms_orientation_error `planner.orientation_tolerance`).
+    """
+    plan = build_plan(config, Path.cwd())
+    p, lead = config.planner, plan.reference.duration
+    with fields_as(_CONFIG_PATHS):
+        check_reach(plan.scene.robot, plan.targets.positions, p.duration)
+        planner = make_planner(p, plan.scene, config.seed)
+        run = track(planner, plan.reference, plan.q0, p.dt, lead + p.duration, p.max_steps,
+                    progress, lead)  # fmt: skip
+    metrics = tracking_metrics(run, plan.scene.robot, p.settle or 0.0, planner.iterations,
+                               plan.targets.cone)  # fmt: skip
+    after = f"{p.settle} s into the path" if lead else f"{p.settle} s"
+    if metrics["rms_error"] > p.tolerance:
+        raise InfeasibleError(
+            f"not tracked: rms error {metrics['rms_error']:.3g} m after {after} (max "
+            f"{metrics['max_error']:.3g} m) exceeds planner.tolerance = {p.tolerance} m; the "
+            "path may be out of reach or blocked",
+            "trajectory",
+        )
+    turned = metrics.get("rms_orientation_error")
+    if turned is not None and turned > p.orientation_tolerance:
+        raise InfeasibleError(
+            f"not tracked: rms orientation error {turned:.3g} rad after {after} (max "
+            f"{metrics['max_orientation_error']:.3g} rad) exceeds planner.orientation_tolerance "
+            f"= {p.orientation_tolerance} rad",
+            "trajectory",
+        )
+    return Result(metrics, trace_columns(run))
+
+
+def load_plan(path: Path) -> dict[str, Any]:
+    """A scene file (or a plan folder's config.toml) as a `baornn.plan` config, its file paths
+    made absolute.
+
+    Args:
+        path: the scene file or config.toml; its relative paths start at its folder.
+
+    Returns:
+        The config's tables as read from TOML, `experiment` set to "baornn.plan" when absent
+            and its URDF, package folders, meshes and trajectory CSV paths made absolute.
+
+    Raises:
+        ConfigError: the file names another experiment (run it with `articula run`).
+    """
+    data = load_toml(path)
+    name = data.setdefault("experiment", NAME)
+    if name != NAME:
+        raise ConfigError(
+            f"{path}: experiment",
+            f"plan runs {NAME} configs (got {name!r}); run this file with `articula run`",
+        )
+    return absolute_paths(data, path.parent)
+
+
+def _with_method(spec: PlannerSpec, method: str, where: str) -> PlannerSpec:
+    """spec with another method, checked as the file's planner.method would be."""
+    return parse_model(PlannerSpec, {**spec.model_dump(), "method": method}, where or "planner")
+
+
+PLAN = Experiment(NAME, PlanConfig, run_plan, absolute_paths)
