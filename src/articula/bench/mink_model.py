@@ -154,18 +154,32 @@ def _add_shape(spec, body, name: str, shape, placement: pin.SE3) -> None:
     geometry = shape.geometry
     kind = shape.kind
     if kind == "box":
-        body.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_BOX,
-                      size=list(geometry.halfSide), **_pose(placement))  # fmt: skip
+        body.add_geom(
+            name=name,
+            type=mujoco.mjtGeom.mjGEOM_BOX,
+            size=list(geometry.halfSide),
+            **_pose(placement),
+        )
     elif kind == "sphere":
-        body.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_SPHERE,
-                      size=[geometry.radius, 0.0, 0.0], **_pose(placement))  # fmt: skip
+        body.add_geom(
+            name=name,
+            type=mujoco.mjtGeom.mjGEOM_SPHERE,
+            size=[geometry.radius, 0.0, 0.0],
+            **_pose(placement),
+        )
     elif kind in ("cylinder", "capsule"):
-        kind_of = {"cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER,
-                   "capsule": mujoco.mjtGeom.mjGEOM_CAPSULE}  # fmt: skip
-        body.add_geom(name=name, type=kind_of[kind],
-                      size=[geometry.radius, geometry.halfLength, 0.0],
-                      **_pose(placement))  # fmt: skip
+        kind_of = {
+            "cylinder": mujoco.mjtGeom.mjGEOM_CYLINDER,
+            "capsule": mujoco.mjtGeom.mjGEOM_CAPSULE,
+        }
+        body.add_geom(
+            name=name,
+            type=kind_of[kind],
+            size=[geometry.radius, geometry.halfLength, 0.0],
+            **_pose(placement),
+        )
     else:  # a convex hull: its vertices; MuJoCo takes their convex hull for collisions
         spec.add_mesh(name=f"mesh:{name}", uservert=np.asarray(shape.vertices).ravel().tolist())
-        body.add_geom(name=name, type=mujoco.mjtGeom.mjGEOM_MESH, meshname=f"mesh:{name}",
-                      **_pose(placement))  # fmt: skip
+        body.add_geom(
+            name=name, type=mujoco.mjtGeom.mjGEOM_MESH, meshname=f"mesh:{name}", **_pose(placement)
+        )

@@ -168,8 +168,14 @@ class MinkArm:
         self._target.wxyz_xyz[4:] = target
         self.task.set_target(self._target)
         try:
-            v = mink.solve_ik(self.configuration, [self.task], self.dt, solver="daqp",
-                              damping=self.damping, limits=self.limits)  # fmt: skip
+            v = mink.solve_ik(
+                self.configuration,
+                [self.task],
+                self.dt,
+                solver="daqp",
+                damping=self.damping,
+                limits=self.limits,
+            )
         except mink.NoSolutionFound:
             self.infeasible += 1
             return self.q

@@ -60,9 +60,20 @@ ATTEMPTS = 100  # draws of a start, path or obstacle before the problem is given
 # paths whose links must pass closer; 5e-5 (7 mm) acts, like the peers' dampers, within a few
 # d_min (success rates at 0.005, 5e-4 and 5e-5: closing note of issue 13). c1, c2 and 10
 # iterations per period are the book's.
-PLANNER = {"lambda_weight": 5e-5, "beta": 1.0, "d_min": D_MIN, "dt": DT, "c1": 0.3,
-           "c2": 0.5, "iterations_per_step": 10, "influence": INFLUENCE, "safety": D_MIN,
-           "settle": SETTLE, "limits": "velocity", "tolerance": 1.0}  # fmt: skip
+PLANNER = {
+    "lambda_weight": 5e-5,
+    "beta": 1.0,
+    "d_min": D_MIN,
+    "dt": DT,
+    "c1": 0.3,
+    "c2": 0.5,
+    "iterations_per_step": 10,
+    "influence": INFLUENCE,
+    "safety": D_MIN,
+    "settle": SETTLE,
+    "limits": "velocity",
+    "tolerance": 1.0,
+}
 
 
 @dataclass(frozen=True)
@@ -97,8 +108,9 @@ def generate(robot_table: dict[str, Any], seed: int, index: int) -> Problem:
         The problem.
     """
     rng = np.random.default_rng([seed, index])
-    robot, checked = _robot(json.dumps({k: v for k, v in robot_table.items() if k != "q0"},
-                                       sort_keys=True))  # fmt: skip
+    robot, checked = _robot(
+        json.dumps({k: v for k, v in robot_table.items() if k != "q0"}, sort_keys=True)
+    )
     for _ in range(ATTEMPTS):
         q0 = _start(robot, checked, rng)
         kind, trajectory, duration = _path(robot.ee_position(q0), rng)
@@ -112,8 +124,13 @@ def generate(robot_table: dict[str, Any], seed: int, index: int) -> Problem:
             continue
         planner = {**PLANNER, "duration": duration, "seed": seed}
         robot_out = {k: v for k, v in robot_table.items() if k != "q0"} | {"q0": q0.tolist()}
-        config = {"experiment": PLAN, "robot": robot_out, "obstacles": obstacles,
-                  "trajectory": trajectory, "planner": planner}  # fmt: skip
+        config = {
+            "experiment": PLAN,
+            "robot": robot_out,
+            "obstacles": obstacles,
+            "trajectory": trajectory,
+            "planner": planner,
+        }
         return Problem(config, meshes, kind)
     raise InfeasibleError(
         f"no problem found in {ATTEMPTS} draws (start, reachable path, obstacle placement)",
@@ -149,8 +166,14 @@ def _path(x0: np.ndarray, rng: np.random.Generator) -> tuple[str, dict[str, Any]
     if rng.random() < 0.5:
         radius = float(rng.uniform(0.05, 0.15))
         center = x0 - radius * u  # Eq. (1.27) starts at center + radius·axis_a
-        table = {"type": "circle", "center": center.tolist(), "axis_a": u.tolist(),
-                 "axis_b": v.tolist(), "radius": radius, "period": period}  # fmt: skip
+        table = {
+            "type": "circle",
+            "center": center.tolist(),
+            "axis_a": u.tolist(),
+            "axis_b": v.tolist(),
+            "radius": radius,
+            "period": period,
+        }
         return "circle", table, period
     end = x0 + float(rng.uniform(0.10, 0.25)) * u
     points = [x0.tolist(), end.tolist(), x0.tolist()]
@@ -181,8 +204,7 @@ def _obstacles(
     """1-4 obstacles beside the motion's links, as [[obstacles]] tables and mesh files; None
     when one cannot be placed."""
     tables, meshes, placed = [], {}, []
-    links = [link for link in robot.links
-             if robot.model.frames[link.frame_id].parentJoint != 0]  # fmt: skip
+    links = [link for link in robot.links if robot.model.frames[link.frame_id].parentJoint != 0]
     for k in range(int(rng.integers(1, 5))):
         kind = ("rock", "box", "sphere", "capsule")[int(rng.integers(4))]
         for _ in range(ATTEMPTS):
@@ -206,8 +228,7 @@ def _obstacles(
                 continue
             placed.append(obstacle)
             name = f"{kind}{k}"
-            tables.append({"name": name, **table, "position": centre.tolist(),
-                           "rpy": rpy.tolist()})  # fmt: skip
+            tables.append({"name": name, **table, "position": centre.tolist(), "rpy": rpy.tolist()})
             if mesh is not None:
                 tables[-1]["mesh"] = f"{name}.stl"
                 meshes[f"{name}.stl"] = mesh

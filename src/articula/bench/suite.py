@@ -90,8 +90,17 @@ def run_suite(
     """
     check_backend(dask)
     key = _suite_key(robot, seed, methods)
-    tasks = [{"robot": robot, "seed": seed, "index": i, "methods": list(methods), "key": key,
-              "folder": str(out / PROBLEMS / f"{i:03d}")} for i in range(problems)]  # fmt: skip
+    tasks = [
+        {
+            "robot": robot,
+            "seed": seed,
+            "index": i,
+            "methods": list(methods),
+            "key": key,
+            "folder": str(out / PROBLEMS / f"{i:03d}"),
+        }
+        for i in range(problems)
+    ]
     with claimed(out, "suite", force):
         done = {t["index"]: rows for t in tasks if (rows := _finished(t)) is not None}
         todo = [t for t in tasks if t["index"] not in done]
@@ -147,8 +156,12 @@ def solve_problem(task: Mapping[str, Any]) -> tuple[int, list[dict[str, Any]]]:
     targets_per_step = [plan.targets(n * DT) for n in range(steps)]
     rows = []
     for method in task["methods"]:
-        row = {"problem": task["index"], "method": method, "path": problem.path_kind,
-               "obstacles": len(config["obstacles"])}  # fmt: skip
+        row = {
+            "problem": task["index"],
+            "method": method,
+            "path": problem.path_kind,
+            "obstacles": len(config["obstacles"]),
+        }
         rows.append(row | _run(method, plan, targets_per_step))
     saved = {"key": task["key"], "rows": rows}
     records.atomic_write(folder / "results.json", json.dumps(saved).encode())
@@ -194,8 +207,13 @@ def _run(method: str, plan: PlanSetup, targets: list) -> dict[str, Any]:
     }
     failure = next((name for name in FAILURES[1:] if failed[name]), None)
     step_us = [round(t / 1e3, 3) for t in times[1:]]
-    return {"success": failure is None, "failure": failure, "message": None, **metrics,
-            "step_us": step_us}  # fmt: skip
+    return {
+        "success": failure is None,
+        "failure": failure,
+        "message": None,
+        **metrics,
+        "step_us": step_us,
+    }
 
 
 def _controller(method: str, plan: PlanSetup) -> Callable[[Any], np.ndarray]:
@@ -233,9 +251,14 @@ def summarize(
         statistics of each method under "methods" and, when a peer ran,
         best_mink_success_rate.
     """
-    out: dict[str, Any] = {"robot": dict(robot), "seed": seed, "problems": problems,
-                           "success_rms_m": SUCCESS_RMS, "settle_s": SETTLE,
-                           "methods": {}}  # fmt: skip
+    out: dict[str, Any] = {
+        "robot": dict(robot),
+        "seed": seed,
+        "problems": problems,
+        "success_rms_m": SUCCESS_RMS,
+        "settle_s": SETTLE,
+        "methods": {},
+    }
     for method in methods:
         mine = [r for r in rows if r["method"] == method]
         times = [t for r in mine for t in r["step_us"]]

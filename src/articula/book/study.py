@@ -60,9 +60,13 @@ class Study:
         """
         total = total or done + len(configs)
         return runner.run_sweep(
-            configs, self.out / name, workers=self.workers, dask=self.dask, force=True,
+            configs,
+            self.out / name,
+            workers=self.workers,
+            dask=self.dask,
+            force=True,
             progress=lambda d, _n: self.progress(done + d, total),
-        )  # fmt: skip
+        )
 
 
 def packaged(chapter: str, name: str) -> Path:

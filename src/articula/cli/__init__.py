@@ -24,8 +24,16 @@ from articula.errors import ArticulaError, CollisionError, DeviceError, Resource
 
 BAD_INPUT, ENVIRONMENT, BUG, COLLIDES, INTERRUPTED = 2, 1, 3, 4, 130
 # OS errors that the machine causes; every other OSError is about a path the user gave.
-MACHINE_ERRNOS = {errno.ENOSPC, errno.EDQUOT, errno.EIO, errno.EBUSY, errno.ENOMEM,
-                  errno.EMFILE, errno.ENFILE, errno.ETXTBSY}  # fmt: skip
+MACHINE_ERRNOS = {
+    errno.ENOSPC,
+    errno.EDQUOT,
+    errno.EIO,
+    errno.EBUSY,
+    errno.ENOMEM,
+    errno.EMFILE,
+    errno.ENFILE,
+    errno.ETXTBSY,
+}
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -43,8 +51,11 @@ def main(argv: list[str] | None = None) -> None:
                 raise
             _fail(*_status_and_message(exc))
         except KeyboardInterrupt:
-            _fail(INTERRUPTED, "interrupted (Ctrl-C); finished work is kept: a sweep resumes, a "
-                  "rig run's folder says it is incomplete")  # fmt: skip
+            _fail(
+                INTERRUPTED,
+                "interrupted (Ctrl-C); finished work is kept: a sweep resumes, a "
+                "rig run's folder says it is incomplete",
+            )
     if caught:
         first = f"{_one_line(str(caught[0].message))} ({caught[0].category.__name__})"
         sys.stderr.write(f"warning: {len(caught)} warning(s), the first: {first}\n")
@@ -79,8 +90,10 @@ def _status_and_message(exc: Exception) -> tuple[int, str]:
         return BAD_INPUT, f"{where}{reason}; check the path and its permissions"
     if isinstance(exc, (OverflowError, FloatingPointError)):
         return BAD_INPUT, f"a number is too large to compute with ({exc}); check the inputs"
-    return BUG, (f"internal error ({type(exc).__name__}: {exc}); please report it with the "
-                 "command (ARTICULA_DEBUG=1 shows the traceback)")  # fmt: skip
+    return BUG, (
+        f"internal error ({type(exc).__name__}: {exc}); please report it with the "
+        "command (ARTICULA_DEBUG=1 shows the traceback)"
+    )
 
 
 def _one_line(text: str) -> str:

@@ -119,6 +119,11 @@ def progress_bar(quiet: bool) -> Progress:
     log or a pipe would only collect its frames), and it leaves no line behind, so that an
     error that ends the work stays the only line."""
     return Progress(
-        TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
-        TimeElapsedColumn(), console=err, disable=quiet or not err.is_terminal, transient=True,
-    )  # fmt: skip
+        TextColumn("[bold]{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=err,
+        disable=quiet or not err.is_terminal,
+        transient=True,
+    )

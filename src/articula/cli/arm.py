@@ -47,16 +47,21 @@ def plan(
     with progress_bar(as_json) as bar:
         task = bar.add_task("plan", total=None)
         record = run_to_folder(
-            load_plan(scene_file), out_dir, str(scene_file), force,
+            load_plan(scene_file),
+            out_dir,
+            str(scene_file),
+            force,
             progress=lambda done, total: bar.update(task, completed=done, total=total),
-        )  # fmt: skip
+        )
     m = record["metrics"]
     if as_json:
         emit_json(record)
     else:
-        clearance = "no obstacles" if m["min_clearance"] is None else (
-            f"min clearance {m['min_clearance']:.4f} m; collisions {int(m['collisions'])}"
-        )  # fmt: skip
+        clearance = (
+            "no obstacles"
+            if m["min_clearance"] is None
+            else (f"min clearance {m['min_clearance']:.4f} m; collisions {int(m['collisions'])}")
+        )
         speed = f"{m['time_per_iteration_us']:.1f} µs per iteration"
         error = f"{1e3 * m['rms_error']:.3f} mm, max {1e3 * m['max_error']:.3f} mm"
         settled = f"after {m['settle_s']:g} s"
@@ -64,8 +69,7 @@ def plan(
             settled = (
                 f"{m['settle_s']:g} s into the path (after a {m['approach_s']:.2g} s approach)"
             )
-        out.print(f"RMS error {settled}: {error}; {clearance}; {speed}; "
-                  f"written to {out_dir}")  # fmt: skip
+        out.print(f"RMS error {settled}: {error}; {clearance}; {speed}; written to {out_dir}")
     if m["collisions"] and not allow_collisions:
         from articula.errors import CollisionError
 
@@ -114,18 +118,27 @@ def scene_check(
         emit_json(result)
         return
     if q_file is not None:
-        rows = [(str(i), f"{r['min_clearance']:.4f}{' collides' if r['collides'] else ''}",
-                 f"{r['self_clearance']:.4f}{' collides' if r['self_collides'] else ''}")
-                for i, r in enumerate(result["configurations"])]  # fmt: skip
+        rows = [
+            (
+                str(i),
+                f"{r['min_clearance']:.4f}{' collides' if r['collides'] else ''}",
+                f"{r['self_clearance']:.4f}{' collides' if r['self_collides'] else ''}",
+            )
+            for i, r in enumerate(result["configurations"])
+        ]
         header = ("row", "min clearance [m]", "self clearance [m]")
         print_table(f"{scene_file} ({metric} metric)", header, rows)
         return
     rows = [(name, f"{value:.4f}") for name, value in result["link_clearance"].items()]
     print_table(f"{scene_file} ({metric} metric)", ("link", "clearance [m]"), rows)
     x, y, z = result["ee_position"]
-    out.print(f"end-effector at ({x:.4f}, {y:.4f}, {z:.4f}) m; minimum clearance "
-              f"{result['min_clearance']:.4f} m; collides: {result['collides']}")  # fmt: skip
+    out.print(
+        f"end-effector at ({x:.4f}, {y:.4f}, {z:.4f}) m; minimum clearance "
+        f"{result['min_clearance']:.4f} m; collides: {result['collides']}"
+    )
     pair = " and ".join(result["self_closest_pair"] or ["no link pair"])
     checked = "" if result["self_collision_checked"] else " (self_collision is off)"
-    out.print(f"self clearance {result['self_clearance']:.4f} m ({pair}); self collides: "
-              f"{result['self_collides']}{checked}")  # fmt: skip
+    out.print(
+        f"self clearance {result['self_clearance']:.4f} m ({pair}); self collides: "
+        f"{result['self_collides']}{checked}"
+    )

@@ -76,9 +76,16 @@ def suite(
     with progress_bar(as_json) as bar:
         task = bar.add_task("suite", total=problems)
         summary = run_suite(
-            table, problems, seed, out_dir, chosen, workers=workers, dask=dask, force=force,
+            table,
+            problems,
+            seed,
+            out_dir,
+            chosen,
+            workers=workers,
+            dask=dask,
+            force=force,
             progress=lambda done, total: bar.update(task, completed=done),
-        )  # fmt: skip
+        )
     summary["results"] = str(out_dir / "results.parquet")
     if missing and methods is None:
         summary["peers_skipped"] = missing
@@ -112,18 +119,23 @@ def _print(summary: dict[str, Any]) -> None:
     """The summary as a table, one row per method."""
     from rich.table import Table
 
-    table = Table(title=f"{summary['problems']} problems, seed {summary['seed']}: success = no "
-                  "collision, limits kept, RMS < 1 mm after 1 s")  # fmt: skip
-    for name in ("method", "success", "median µs", "p99 µs", "RMS mm", "min clear. mm",
-                 "failures"):  # fmt: skip
+    table = Table(
+        title=f"{summary['problems']} problems, seed {summary['seed']}: success = no "
+        "collision, limits kept, RMS < 1 mm after 1 s"
+    )
+    for name in ("method", "success", "median µs", "p99 µs", "RMS mm", "min clear. mm", "failures"):
         table.add_column(name, justify="left" if name in ("method", "failures") else "right")
     for method, m in summary["methods"].items():
         failures = ", ".join(f"{k} {v}" for k, v in m["failures"].items() if v) or "—"
         table.add_row(
-            method, f"{100 * m['success_rate']:.0f} %", _number(m["median_step_us"], 0),
-            _number(m["p99_step_us"], 0), _number(m["median_rms_error_m"], 3, 1e3),
-            _number(m["min_clearance_m"], 1, 1e3), failures,
-        )  # fmt: skip
+            method,
+            f"{100 * m['success_rate']:.0f} %",
+            _number(m["median_step_us"], 0),
+            _number(m["p99_step_us"], 0),
+            _number(m["median_rms_error_m"], 3, 1e3),
+            _number(m["min_clearance_m"], 1, 1e3),
+            failures,
+        )
     out.print(table)
     if "peers_skipped" in summary:
         out.print(f"mink skipped: {summary['peers_skipped']}")

@@ -79,12 +79,16 @@ def motor_analyze(
         emit_json(result)
         return
     ss = result["steady_state"]
-    out.print(f"A = {_numbers(result['A'])}\nB = {_numbers(result['B'])}\n"
-              f"poles = {_numbers(result['poles'])}")  # fmt: skip
+    out.print(
+        f"A = {_numbers(result['A'])}\nB = {_numbers(result['B'])}\n"
+        f"poles = {_numbers(result['poles'])}"
+    )
     for k, tf in result["transfer"].items():
         out.print(f"{k:>13}: num {_numbers(tf['num'])}  den {_numbers(tf['den'])}")
-    out.print(f"steady state at V={voltage} V, τ_ex={torque} N·m: "
-              f"ω = {ss['omega']:.6g} rad/s, i = {ss['i']:.6g} A")  # fmt: skip
+    out.print(
+        f"steady state at V={voltage} V, τ_ex={torque} N·m: "
+        f"ω = {ss['omega']:.6g} rad/s, i = {ss['i']:.6g} A"
+    )
     if result["omega_c"] is None:
         out.print(f"ω_c: none ({result['omega_c_note']})")
     else:

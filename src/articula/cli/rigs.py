@@ -71,8 +71,11 @@ def emulate(
         raise ConfigError("--plant", "only the motor rig takes a plant config")
     if firmware is not None:
         if faults:
-            raise ConfigError("--faults", "faults are injected by the Python device, not on "
-                              "firmware; leave out --firmware or --faults")  # fmt: skip
+            raise ConfigError(
+                "--faults",
+                "faults are injected by the Python device, not on "
+                "firmware; leave out --firmware or --faults",
+            )
         emulator = _firmware_rig(rig, firmware, plant, realtime)
     else:
         from articula.rigs.emulator import Emulator, Faults
@@ -158,8 +161,10 @@ def info(port: Port, as_json: JsonFlag = False) -> None:
     if as_json:
         emit_json(summary)
         return
-    out.print(f"{summary['rig']} rig on {port}: protocol {i.protocol}, firmware "
-              f"{summary['firmware']}, a sample every {i.sample_period_us} µs")  # fmt: skip
+    out.print(
+        f"{summary['rig']} rig on {port}: protocol {i.protocol}, firmware "
+        f"{summary['firmware']}, a sample every {i.sample_period_us} µs"
+    )
     for c in i.channels:
         out.print(escape(f"  {c.name} [{c.unit}]"))
     out.print(f"last started by: {summary['reset']}")
@@ -203,8 +208,9 @@ def run_(
         return
     exp, cfg = parse_config(data, str(config))
     if exp.name not in RIG_RUNS:
-        raise ConfigError("experiment", f"{exp.name} does not run on a rig yet; rig runs: "
-                          f"{', '.join(RIG_RUNS)}")  # fmt: skip
+        raise ConfigError(
+            "experiment", f"{exp.name} does not run on a rig yet; rig runs: {', '.join(RIG_RUNS)}"
+        )
     module, rig = RIG_RUNS[exp.name]
     driver = importlib.import_module(module)
     # The folder is checked before the rig is touched and made only once the rig has answered
@@ -218,12 +224,15 @@ def run_(
         return
     print_table(f"{exp.name} on {port}", ("metric", "value"), metric_rows(record["metrics"]))
     lost = record["link"]
-    out.print(f"{record['samples']} samples; line: {lost['crc_errors']} damaged, "
-              f"{lost['dropped']} lost, {lost['resends']} resent; in {out_dir}")  # fmt: skip
+    out.print(
+        f"{record['samples']} samples; line: {lost['crc_errors']} damaged, "
+        f"{lost['dropped']} lost, {lost['resends']} resent; in {out_dir}"
+    )
 
 
-def _repeat_recording(port: str, data: dict, config: Path, out_dir: Path, force: bool,
-                      as_json: bool) -> None:  # fmt: skip
+def _repeat_recording(
+    port: str, data: dict, config: Path, out_dir: Path, force: bool, as_json: bool
+) -> None:
     """`rig run` of a recording's config.toml: its settings sent, its run again."""
     from articula.rigs.link import Link
     from articula.rigs.recorder import Recorder
@@ -327,8 +336,9 @@ def tune(
     from articula.validation import load_toml, parse_model
 
     if method not in TUNERS:
-        raise ConfigError("--method", f"unknown tuner {method!r}; choose one of "
-                          f"{', '.join(TUNERS)}")  # fmt: skip
+        raise ConfigError(
+            "--method", f"unknown tuner {method!r}; choose one of {', '.join(TUNERS)}"
+        )
     try:
         chosen = tuple(float(v) for v in levels.split(","))
     except ValueError:
@@ -348,5 +358,7 @@ def tune(
         emit_json(result)
         return
     kp, ki, kd = result["gains"]
-    out.print(f"{method}: K_p = {kp:.4g}, K_i = {ki:.4g}, K_d = {kd:.4g} after "
-              f"{result['experiments']} experiments; in {out_dir / TUNING}")  # fmt: skip
+    out.print(
+        f"{method}: K_p = {kp:.4g}, K_i = {ki:.4g}, K_d = {kd:.4g} after "
+        f"{result['experiments']} experiments; in {out_dir / TUNING}"
+    )

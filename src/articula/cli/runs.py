@@ -85,15 +85,22 @@ def sweep(
 
     with progress_bar(as_json) as bar:
         task = bar.add_task("sweep", total=len(configs))
-        table = run_sweep(configs, out_dir, workers=workers, dask=dask, force=force,
-                          progress=report)  # fmt: skip
+        table = run_sweep(
+            configs, out_dir, workers=workers, dask=dask, force=force, progress=report
+        )
     failed = sum(error is not None for error in table.column("error").to_pylist())
     skipped = finished_before[0] if finished_before else 0
-    summary = {"runs": table.num_rows, "skipped": skipped, "failed": failed,
-               "results": str(out_dir / RESULTS)}  # fmt: skip
+    summary = {
+        "runs": table.num_rows,
+        "skipped": skipped,
+        "failed": failed,
+        "results": str(out_dir / RESULTS),
+    }
     if as_json:
         emit_json(summary)
     else:
         note = f" ({failed} could not be done: see the error column)" if failed else ""
-        out.print(f"{summary['runs']} runs, {summary['runs'] - skipped} computed and {skipped} "
-                  f"already finished{note}; results in {summary['results']}")  # fmt: skip
+        out.print(
+            f"{summary['runs']} runs, {summary['runs'] - skipped} computed and {skipped} "
+            f"already finished{note}; results in {summary['results']}"
+        )

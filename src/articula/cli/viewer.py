@@ -61,5 +61,6 @@ def live(
         )
     if record is not None:
         check_out(record, "run", force, option="--record")
-    run_live(scene, method, host, port, record,
-             lambda url: out.print(f"live at {url} (Ctrl-C stops it)"))  # fmt: skip
+    run_live(
+        scene, method, host, port, record, lambda url: out.print(f"live at {url} (Ctrl-C stops it)")
+    )

@@ -9,8 +9,16 @@ from __future__ import annotations
 import typer
 from typer.core import TyperArgument, TyperGroup, TyperOption
 
-WORDS = {"int": "INTEGER", "int range": "INTEGER", "float": "NUMBER", "float range": "NUMBER",
-         "str": "TEXT", "path": "PATH", "file": "FILE", "directory": "FOLDER"}  # fmt: skip
+WORDS = {
+    "int": "INTEGER",
+    "int range": "INTEGER",
+    "float": "NUMBER",
+    "float range": "NUMBER",
+    "str": "TEXT",
+    "path": "PATH",
+    "file": "FILE",
+    "directory": "FOLDER",
+}
 
 
 class WordArgument(TyperArgument):

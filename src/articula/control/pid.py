@@ -37,8 +37,8 @@ class GainSchedule:
     """
 
     kind: ScheduleKind
-    gains: np.ndarray  # (rows, 3)
-    points: np.ndarray = field(default_factory=lambda: np.zeros(1))  # (rows,)
+    gains: np.ndarray
+    points: np.ndarray = field(default_factory=lambda: np.zeros(1))
 
     def __post_init__(self) -> None:
         gains = np.atleast_2d(np.array(self.gains, dtype=float))

@@ -191,10 +191,12 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
     with fields_as(_CONFIG_PATHS):
         check_reach(plan.scene.robot, plan.targets.positions, p.duration)
         planner = make_planner(p, plan.scene, config.seed)
-        run = track(planner, plan.reference, plan.q0, p.dt, lead + p.duration, p.max_steps,
-                    progress, lead)  # fmt: skip
-    metrics = tracking_metrics(run, plan.scene.robot, p.settle or 0.0, planner.iterations,
-                               plan.targets.cone)  # fmt: skip
+        run = track(
+            planner, plan.reference, plan.q0, p.dt, lead + p.duration, p.max_steps, progress, lead
+        )
+    metrics = tracking_metrics(
+        run, plan.scene.robot, p.settle or 0.0, planner.iterations, plan.targets.cone
+    )
     after = f"{p.settle} s into the path" if lead else f"{p.settle} s"
     if metrics["rms_error"] > p.tolerance:
         raise InfeasibleError(

@@ -104,8 +104,9 @@ def convex_parts(
         coacd.set_log_level("error")
         # CoACD repairs non-manifold input itself ("manifold" preprocessing); its seed is fixed
         # so that the same file always gives the same parts.
-        parts = coacd.run_coacd(coacd.Mesh(vertices, faces), threshold=threshold,
-                                preprocess_mode="auto", seed=0)  # fmt: skip
+        parts = coacd.run_coacd(
+            coacd.Mesh(vertices, faces), threshold=threshold, preprocess_mode="auto", seed=0
+        )
         pieces = [np.asarray(v, dtype=float) for v, _ in parts]
         _store(key, pieces)
     return [convex_hull(v, f"{name}[{i}]") for i, v in enumerate(pieces)]

@@ -21,9 +21,19 @@ from articula.plants.motor_sensors import encoder_count, read_current
 CHANNELS = ("i", "i_meas", "i_fb", "omega", "omega_meas", "v1", "duty1", "v2")
 # Running sums the loop keeps per trial, so metrics need no stored trace (see loop_metrics).
 SUMS = (
-    "error", "error_sq", "noise_sq", "omega", "saturated",
-    "t10", "t90", "t10_fb", "t90_fb", "i", "i_sin", "i_cos",
-)  # fmt: skip
+    "error",
+    "error_sq",
+    "noise_sq",
+    "omega",
+    "saturated",
+    "t10",
+    "t90",
+    "t10_fb",
+    "t90_fb",
+    "i",
+    "i_sin",
+    "i_cos",
+)
 
 
 @dataclass(frozen=True)
@@ -51,23 +61,23 @@ class LoopSettings:
         encoder_window: samples over which the encoder's count difference gives the speed.
     """
 
-    dt: float  # [s]
-    v_bias: float  # [V] constant feed-forward of Eq. (4.13)
-    kp: float  # [V/A]
-    ki: float  # [V/(A·s)]
+    dt: float
+    v_bias: float
+    kp: float
+    ki: float
     filter_order: int
     dual: bool
-    kp_speed: float  # [V·s/rad]
-    ki_speed: float  # [V/rad]
-    v_max: float  # [V]
-    pwm_bits: int  # 0: ideal driver (saturation only)
+    kp_speed: float
+    ki_speed: float
+    v_max: float
+    pwm_bits: int
     sensor_ideal: bool
-    sensitivity: float  # [V/A]
-    zero_voltage: float  # [V]
-    noise_sigma: float  # [V]
+    sensitivity: float
+    zero_voltage: float
+    noise_sigma: float
     adc_bits: int
-    adc_vref: float  # [V]
-    encoder_cpr: int  # 0: ideal speed measurement
+    adc_vref: float
+    encoder_cpr: int
     encoder_window: int
 
 
@@ -81,9 +91,9 @@ class MetricWindow:
         frequency: frequency of the sinusoidal reference [rad/s]; 0: no sinusoid fit.
     """
 
-    settle_index: int  # first sample of the steady-state window
-    rise_target: float  # [A] step target for 10-90 % rise times; NaN: no rise time
-    frequency: float  # [rad/s] of the sinusoidal reference; 0: no sinusoid fit
+    settle_index: int
+    rise_target: float
+    frequency: float
 
 
 def simulate_loop(
@@ -123,14 +133,37 @@ def simulate_loop(
     t = np.arange(steps) * settings.dt
     s = settings
     _loop(
-        Ad, Bd, np.ascontiguousarray(i_ref, dtype=float), float(omega_ref),
-        np.ascontiguousarray(noise.T), out, sums, record,
-        window.settle_index, window.rise_target, np.sin(window.frequency * t),
+        Ad,
+        Bd,
+        np.ascontiguousarray(i_ref, dtype=float),
+        float(omega_ref),
+        np.ascontiguousarray(noise.T),
+        out,
+        sums,
+        record,
+        window.settle_index,
+        window.rise_target,
+        np.sin(window.frequency * t),
         np.cos(window.frequency * t),
-        s.dt, s.v_bias, s.kp, s.ki, s.filter_order, s.dual, s.kp_speed, s.ki_speed,
-        s.v_max, s.pwm_bits, s.sensor_ideal, s.sensitivity, s.zero_voltage, s.noise_sigma,
-        s.adc_bits, s.adc_vref, s.encoder_cpr, s.encoder_window,
-    )  # fmt: skip
+        s.dt,
+        s.v_bias,
+        s.kp,
+        s.ki,
+        s.filter_order,
+        s.dual,
+        s.kp_speed,
+        s.ki_speed,
+        s.v_max,
+        s.pwm_bits,
+        s.sensor_ideal,
+        s.sensitivity,
+        s.zero_voltage,
+        s.noise_sigma,
+        s.adc_bits,
+        s.adc_vref,
+        s.encoder_cpr,
+        s.encoder_window,
+    )
     channels = {name: out[c].T for c, name in enumerate(CHANNELS)} if record else None
     return channels, dict(zip(SUMS, sums, strict=True))
 
@@ -146,12 +179,37 @@ def _actuate(voltage: float, v_max: float, bits: int) -> tuple[float, float]:
 
 @jit(error_model="numpy")
 def _loop(
-    Ad, Bd, i_ref, omega_ref, noise, out, sums, record,
-    settle_index, rise_target, sin_t, cos_t,
-    dt, v_bias, kp, ki, filter_order, dual, kp_speed, ki_speed,
-    v_max, pwm_bits, sensor_ideal, sensitivity, zero_voltage, noise_sigma,
-    adc_bits, adc_vref, encoder_cpr, encoder_window,
-):  # fmt: skip
+    Ad,
+    Bd,
+    i_ref,
+    omega_ref,
+    noise,
+    out,
+    sums,
+    record,
+    settle_index,
+    rise_target,
+    sin_t,
+    cos_t,
+    dt,
+    v_bias,
+    kp,
+    ki,
+    filter_order,
+    dual,
+    kp_speed,
+    ki_speed,
+    v_max,
+    pwm_bits,
+    sensor_ideal,
+    sensitivity,
+    zero_voltage,
+    noise_sigma,
+    adc_bits,
+    adc_vref,
+    encoder_cpr,
+    encoder_window,
+):
     steps, batch = noise.shape
     n_states = Ad.shape[0]
     x = np.zeros((n_states, batch))
@@ -178,9 +236,14 @@ def _loop(
                 i_meas[b] = i_true[b]
             else:
                 i_meas[b] = read_current(
-                    i_true[b], noise[n, b], sensitivity, zero_voltage, noise_sigma,
-                    adc_bits, adc_vref,
-                )  # fmt: skip
+                    i_true[b],
+                    noise[n, b],
+                    sensitivity,
+                    zero_voltage,
+                    noise_sigma,
+                    adc_bits,
+                    adc_vref,
+                )
         moving_average_push(filt, n, i_meas, i_fb)  # Eq. (4.17) as a mean
         # The same filter on the true current separates sensor noise from filter lag.
         moving_average_push(filt_true, n, i_true, i_true_fb)
@@ -204,8 +267,9 @@ def _loop(
                 # positive V₂ brakes the shaft, hence the minus sign.
                 error_speed = omega_ref - omega_meas
                 integral_speed[b] += error_speed * dt
-                v2[b], _ = _actuate(-(kp_speed * error_speed + ki_speed * integral_speed[b]),
-                                    v_max, pwm_bits)  # fmt: skip
+                v2[b], _ = _actuate(
+                    -(kp_speed * error_speed + ki_speed * integral_speed[b]), v_max, pwm_bits
+                )
             if record:
                 out[0, n, b] = i_true[b]
                 out[1, n, b] = i_meas[b]

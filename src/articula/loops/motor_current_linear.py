@@ -66,8 +66,9 @@ def closed_loop(Ad: np.ndarray, Bd: np.ndarray, s: LoopSettings) -> ct.StateSpac
     # Eq. (4.12) through the reversed secondary: v2 = PI_ω·ω about the operating point.
     speed_pi = ct.ss(
         pi_discrete(s.kp_speed, s.ki_speed, s.dt) * (1.0 if s.dual else 0.0),
-        inputs="omega", outputs="v2",
-    )  # fmt: skip
+        inputs="omega",
+        outputs="v2",
+    )
     return ct.interconnect(
         [plant, filt, error, current_pi, speed_pi], inplist=["r"], outlist=["i"], dt=s.dt
     )

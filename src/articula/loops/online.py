@@ -110,8 +110,14 @@ class OnlineController:
             for o in scene.obstacles:
                 live[o.name] = LivePose(o.pose_at(0.0))
                 obstacles.append(Obstacle(o.name, o.parts, live[o.name]))
-            scene = Scene(scene.robot, obstacles, scene.broadphase, scene.metric,
-                          scene.self_pair_names, scene.self_d_min)  # fmt: skip
+            scene = Scene(
+                scene.robot,
+                obstacles,
+                scene.broadphase,
+                scene.metric,
+                scene.self_pair_names,
+                scene.self_d_min,
+            )
         return cls(make_planner(spec, scene, seed), spec.dt, live)
 
     def reset(

@@ -38,9 +38,9 @@ class Deactuation:
 
     sim: Simulation
     sensor_t: np.ndarray
-    sensor_bend: np.ndarray  # (n, 2) [rad], bending vector from the sensor's roll/pitch/yaw
-    direction: np.ndarray  # unit vector toward which the side bends the body
-    t_off: float  # deactuation instant [s]
+    sensor_bend: np.ndarray
+    direction: np.ndarray
+    t_off: float
 
 
 def valve_program(
@@ -76,10 +76,16 @@ def valve_program(
 
 
 def deactuate(
-    p: SixChamberParams, sensor: OrientationSensorParams, program: ValveSchedule,
-    side_deg: float, hold: float, after: float, dt: float, record_every: int,
+    p: SixChamberParams,
+    sensor: OrientationSensorParams,
+    program: ValveSchedule,
+    side_deg: float,
+    hold: float,
+    after: float,
+    dt: float,
+    record_every: int,
     rng: np.random.Generator,
-) -> Deactuation:  # fmt: skip
+) -> Deactuation:
     """Run `program` for hold + after [s] at step dt [s], keeping every record_every-th
     sample, and read the sensor (its noise from `rng`).
 

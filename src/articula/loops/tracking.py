@@ -126,9 +126,21 @@ def track(
             if self_clearance is not None:
                 self_clearance[n] = d_self
     error = np.linalg.norm(x - x_ref, axis=1)
-    return PlanResult(t, qs, x, x_ref, error, clearance, planner_seconds, first_period_seconds,
-                      q_start, orientation, self_clearance, path_start,
-                      planner.infeasible)  # fmt: skip
+    return PlanResult(
+        t,
+        qs,
+        x,
+        x_ref,
+        error,
+        clearance,
+        planner_seconds,
+        first_period_seconds,
+        q_start,
+        orientation,
+        self_clearance,
+        path_start,
+        planner.infeasible,
+    )
 
 
 def tracking_metrics(

@@ -99,13 +99,13 @@ class BeetleSearch:
             return None
         obj = self.objective
         brake = np.clip(q, *self._box)
-        start = obj.project_and_value(brake, brake, math.inf, target, t, (brake, brake),
-                                      self._stop)  # fmt: skip
+        start = obj.project_and_value(brake, brake, math.inf, target, t, (brake, brake), self._stop)
         self.evaluations += 1
         last = self.rate.last_motion
         if last is not None:
-            coast = obj.project_and_value(q + last, brake, math.inf, target, t, self._box,
-                                          self._stop)  # fmt: skip
+            coast = obj.project_and_value(
+                q + last, brake, math.inf, target, t, self._box, self._stop
+            )
             self.evaluations += 1
             if coast[1] < start[1]:
                 start = coast
@@ -180,9 +180,16 @@ class Baornn(BeetleSearch):
         if obj.compiled is not None:
             self.evaluations += 3
             self.iterations += 1
-            return kernel.iterations(q, g, target.position, obj.orient_arguments(target),
-                                     b[None, :], self.params.c1, self.params.c2,
-                                     *obj.kernel_arguments(self._box, t, self._stop))  # fmt: skip
+            return kernel.iterations(
+                q,
+                g,
+                target.position,
+                obj.orient_arguments(target),
+                b[None, :],
+                self.params.c1,
+                self.params.c2,
+                *obj.kernel_arguments(self._box, t, self._stop),
+            )
         b /= math.sqrt(b @ b)  # a normalised random direction
         lam = self.params.c1 * np.sqrt(g) if np.isfinite(g) else self.params.c1  # Eq. (1.23)
         # Eqs. (1.15)-(1.18): antennae, projected onto Ω, evaluated by "virtual robots".
@@ -219,9 +226,16 @@ class Baornn(BeetleSearch):
             directions = self.rng.standard_normal((k, q.size))
             self.evaluations += 3 * k
             self.iterations += k
-            q, g = kernel.iterations(q, g, target.position, obj.orient_arguments(target),
-                                     directions, self.params.c1, self.params.c2,
-                                     *obj.kernel_arguments(self._box, t, self._stop))  # fmt: skip
+            q, g = kernel.iterations(
+                q,
+                g,
+                target.position,
+                obj.orient_arguments(target),
+                directions,
+                self.params.c1,
+                self.params.c2,
+                *obj.kernel_arguments(self._box, t, self._stop),
+            )
             return self._end_period(start, q, g)
         for _ in range(k):
             q, g = self.iterate(q, g, target, t)

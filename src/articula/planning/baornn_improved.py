@@ -88,10 +88,12 @@ class ImprovedBaornn(BeetleSearch):
             scale = kernel.antenna_scale(j, p.short_antenna)
             length = scale * lam
             # Eq. (1.15): the two antennae.
-            q_left, g_left = obj.project_and_value(q + length * b, q, g, target, t, self._box,
-                                                   self._stop)  # fmt: skip
-            q_right, g_right = obj.project_and_value(q - length * b, q, g, target, t, self._box,
-                                                     self._stop)  # fmt: skip
+            q_left, g_left = obj.project_and_value(
+                q + length * b, q, g, target, t, self._box, self._stop
+            )
+            q_right, g_right = obj.project_and_value(
+                q - length * b, q, g, target, t, self._box, self._stop
+            )
             if np.isfinite(g_left) and np.isfinite(g_right):
                 # A difference over a shorter antenna counts as much per unit length.
                 gradient += (g_left - g_right) / scale * b
@@ -182,9 +184,17 @@ class ImprovedBaornn(BeetleSearch):
         obstacles at time t."""
         obj, p = self.objective, self.params
         q, g, evaluations = kernel.improved_period(
-            q, g, warm, target.position, obj.orient_arguments(target), draws, p.c1, p.c2,
-            p.short_antenna, *obj.kernel_arguments(self._box, t, self._stop),
-        )  # fmt: skip
+            q,
+            g,
+            warm,
+            target.position,
+            obj.orient_arguments(target),
+            draws,
+            p.c1,
+            p.c2,
+            p.short_antenna,
+            *obj.kernel_arguments(self._box, t, self._stop),
+        )
         self.evaluations += evaluations
         self.iterations += draws.shape[0]
         return q, g

@@ -86,8 +86,9 @@ class RowSource:
             return end, ClearanceRows(np.zeros(0), np.zeros((0, q.size)), np.zeros(0, bool))
         rows = clearance_rows(self.scene, q, t, influence)
         moving = np.any(rows.gradient != 0.0, axis=1)  # as the compiled rows: none fixed
-        return end, ClearanceRows(rows.distance[moving], rows.gradient[moving],
-                                  rows.self_pair[moving])  # fmt: skip
+        return end, ClearanceRows(
+            rows.distance[moving], rows.gradient[moving], rows.self_pair[moving]
+        )
 
 
 def clearance_rows(scene: Scene, q: np.ndarray, t: float, influence: float) -> ClearanceRows:

@@ -83,8 +83,8 @@ class TrajectorySpec(StrictModel):
     times: list[Finite] | None = None
     path: str | None = None
     # The tool's orientation (pose task): fixed, or one per waypoint (interpolated by slerp).
-    rpy: Rpy | None = None  # [rad] roll, pitch, yaw about the world's x, y, z
-    quaternion: Quaternion | None = None  # [w, x, y, z]
+    rpy: Rpy | None = None
+    quaternion: Quaternion | None = None
     rpys: list[Rpy] | None = None
     quaternions: list[Quaternion] | None = None
     # The tool axis's direction (position+axis task) and how far from it it may be [rad].
@@ -159,14 +159,14 @@ class PlannerSpec(StrictModel):
     """
 
     method: Method = "baornn"
-    lambda_weight: NonNegative = 0.0  # Λ of Eq. (1.11)
+    lambda_weight: NonNegative = 0.0
     beta: NonNegative = 1.0
-    d_min: NonNegative = 0.0  # [m], Eq. (1.12)
-    dt: Positive = 0.01  # [s] control period
+    d_min: NonNegative = 0.0
+    dt: Positive = 0.01
     iterations_per_step: Annotated[int, Field(ge=1, le=10_000)] = 10
-    duration: Positive = 50.0  # [s]
-    settle: NonNegative | None = None  # [s] before rms_error and max_error; default min(5, T/2)
-    tolerance: Positive = 0.05  # [m] an rms_error above it means the path was not tracked
+    duration: Positive = 50.0
+    settle: NonNegative | None = None
+    tolerance: Positive = 0.05
     orientation_tolerance: Annotated[float, Field(gt=0, le=np.pi, allow_inf_nan=False)] = 0.05
     c1: Positive = 0.5
     c2: Positive = 0.5
@@ -178,7 +178,7 @@ class PlannerSpec(StrictModel):
     influence: Positive = 0.15
     safety: NonNegative = 0.03
     seed: Seed | None = None
-    max_steps: Annotated[int, Field(ge=1, le=10**9)] = MAX_STEPS  # refuse longer runs
+    max_steps: Annotated[int, Field(ge=1, le=10**9)] = MAX_STEPS
     limits: Limits = "velocity+acceleration"
     velocity_scale: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 1.0
     max_acceleration: Positive | None = None
@@ -188,8 +188,8 @@ class PlannerSpec(StrictModel):
     # What the end effector tracks (beyond the book's position): the trajectory's orientation
     # or tool axis; without one given, the start's is held.
     task: TaskKind = "position"
-    orientation_weight: NonNegative = 0.1  # [m/rad] BAORNN's weight on the orientation error
-    tool_axis: Point = Field(default_factory=lambda: [0.0, 0.0, 1.0])  # in the ee frame
+    orientation_weight: NonNegative = 0.1
+    tool_axis: Point = Field(default_factory=lambda: [0.0, 0.0, 1.0])
 
     @model_validator(mode="after")
     def _times(self) -> PlannerSpec:
@@ -242,18 +242,29 @@ def _planner(spec: PlannerSpec, scene: Scene, seed: int) -> Planner:
         params = BaornnParams(c1=spec.c1, c2=spec.c2, iterations_per_step=spec.iterations_per_step)
         return Baornn(objective, params, rng, rate)
     if spec.method == "baornn-improved":
-        improved = ImprovedParams(c1=spec.c1, c2=spec.c2, pairs=spec.pairs,
-                                  short_antenna=spec.short_antenna,
-                                  iterations_per_step=spec.iterations_per_step)  # fmt: skip
+        improved = ImprovedParams(
+            c1=spec.c1,
+            c2=spec.c2,
+            pairs=spec.pairs,
+            short_antenna=spec.short_antenna,
+            iterations_per_step=spec.iterations_per_step,
+        )
         return ImprovedBaornn(objective, improved, rng, rate)
     if spec.method == "qp":
-        qp = QpIkParams(gain=spec.gain, influence=spec.influence, safety=spec.safety,
-                        speed_scale=spec.velocity_scale)  # fmt: skip
+        qp = QpIkParams(
+            gain=spec.gain,
+            influence=spec.influence,
+            safety=spec.safety,
+            speed_scale=spec.velocity_scale,
+        )
         return QpIk(scene, spec.dt, qp, spec.d_min, task, rate=rate)
     velocity = VelocityIkParams(
-        gain=spec.gain, damping=spec.damping, repulsion=spec.repulsion, influence=spec.influence,
+        gain=spec.gain,
+        damping=spec.damping,
+        repulsion=spec.repulsion,
+        influence=spec.influence,
         speed_scale=spec.velocity_scale,
-    )  # fmt: skip
+    )
     return VelocityIk(scene, spec.method, spec.dt, velocity, spec.d_min, task, rate=rate)
 
 
@@ -337,8 +348,13 @@ def make_targets(spec: TrajectorySpec, base_dir: Path) -> TargetPath:
 def _trajectory(spec: TrajectorySpec, base_dir: Path) -> Circle | Waypoints:
     """make_trajectory without the renaming of its errors."""
     if spec.type == "circle":
-        return Circle.create(spec.center or [], spec.axis_a or [], spec.axis_b or [],
-                             spec.radius or 0.0, spec.period or 0.0)  # fmt: skip
+        return Circle.create(
+            spec.center or [],
+            spec.axis_a or [],
+            spec.axis_b or [],
+            spec.radius or 0.0,
+            spec.period or 0.0,
+        )
     if spec.type == "rectangle":
         return rectangle(spec.vertices or [], spec.period or 0.0)
     if spec.type == "waypoints":

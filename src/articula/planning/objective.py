@@ -59,7 +59,7 @@ class Objective:
     """
 
     scene: Scene
-    lambda_weight: float  # Λ [m^(1+β)]
+    lambda_weight: float
     beta: float = 1.0
     d_min: float = 0.0
     use_compiled: bool = True
@@ -100,8 +100,17 @@ class Objective:
             # A period's reach, and where braking from it ends: far obstacles drop out.
             pairs = c.near_pairs(pairs, _braking_box(box, stop))
         lower, upper = box or (robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
-        return (self.lambda_weight, self.beta, self.d_min, self.self_d_min, lower, upper,
-                tuple(stop), c.arrays(pairs), static_min)  # fmt: skip
+        return (
+            self.lambda_weight,
+            self.beta,
+            self.d_min,
+            self.self_d_min,
+            lower,
+            upper,
+            tuple(stop),
+            c.arrays(pairs),
+            static_min,
+        )
 
     @cached_property
     def sweep(self) -> np.ndarray:
@@ -242,8 +251,9 @@ class Objective:
         c = self.compiled
         if c is not None:
             pairs, static_min = c.select(self.needs_obstacles, True)
-            return stoppable(q, d, d_self, self.d_min, self.self_d_min, tuple(stop),
-                             c.arrays(pairs), static_min)  # fmt: skip
+            return stoppable(
+                q, d, d_self, self.d_min, self.self_d_min, tuple(stop), c.arrays(pairs), static_min
+            )
         q_stop = q + braking_travel(q - stop.q_base, stop.change)
         d_stop, d_self_stop = self.scene.clearances(q_stop, t)
         if not self.needs_obstacles:

@@ -126,12 +126,27 @@ class QpIk(ResolvedRate):
         model = robot.model
         change = self._limits.change
         H, A, upper, lower, sense, relaxed = _qp_arrays(
-            q, model.lowerPositionLimit, model.upperPositionLimit, qdot_low, qdot_high,
-            np.full(n, np.inf) if change is None else change, self.dt,
-            J, v, rows.distance, rows.gradient, rows.self_pair,
-            max(p.safety, self.d_min), max(p.self_safety, self.scene.self_d_min), p.influence,
-            p.damper_gain, p.limit_influence, p.limit_safety, p.joint_weight, p.slack_weight,
-        )  # fmt: skip
+            q,
+            model.lowerPositionLimit,
+            model.upperPositionLimit,
+            qdot_low,
+            qdot_high,
+            np.full(n, np.inf) if change is None else change,
+            self.dt,
+            J,
+            v,
+            rows.distance,
+            rows.gradient,
+            rows.self_pair,
+            max(p.safety, self.d_min),
+            max(p.self_safety, self.scene.self_d_min),
+            p.influence,
+            p.damper_gain,
+            p.limit_influence,
+            p.limit_safety,
+            p.joint_weight,
+            p.slack_weight,
+        )
         solution, _, status, _ = daqp.solve(H, np.zeros(H.shape[0]), A, upper, lower, sense)
         self.iterations += 1
         if status <= 0:
@@ -141,10 +156,27 @@ class QpIk(ResolvedRate):
 
 @jit()
 def _qp_arrays(
-    q, q_lower, q_upper, qdot_low, qdot_high, change, dt, J, v, distance, gradient, self_pair,
-    safety, self_safety, influence, damper_gain, limit_influence, limit_safety, joint_weight,
+    q,
+    q_lower,
+    q_upper,
+    qdot_low,
+    qdot_high,
+    change,
+    dt,
+    J,
+    v,
+    distance,
+    gradient,
+    self_pair,
+    safety,
+    self_safety,
+    influence,
+    damper_gain,
+    limit_influence,
+    limit_safety,
+    joint_weight,
     slack_weight,
-):  # fmt: skip
+):
     """daqp's (H, A, upper, lower, sense) of one period, and whether a damper was relaxed: box
     bounds on (q̇, δ) (q̇ within [qdot_low, qdot_high]), then the inequality rows G x ≤ h, then
     the task rows J q̇ + δ = v (sense 5, equality).

@@ -101,7 +101,7 @@ class RateLimits:
 
 
 @jit()
-def _box(q, lower, upper, reach, change, last):  # fmt: skip
+def _box(q, lower, upper, reach, change, last):
     """RateLimits.box in one compiled call: (lower, upper, strained); change is inf for a joint
     without an acceleration limit."""
     n = q.size

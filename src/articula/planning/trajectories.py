@@ -44,9 +44,13 @@ class Circle:
 
     @classmethod
     def create(
-        cls, center: Sequence[float], axis_a: Sequence[float], axis_b: Sequence[float],
-        radius: float, period: float,
-    ) -> Circle:  # fmt: skip
+        cls,
+        center: Sequence[float],
+        axis_a: Sequence[float],
+        axis_b: Sequence[float],
+        radius: float,
+        period: float,
+    ) -> Circle:
         """A validated circle: A and B must be perpendicular unit vectors.
 
         Args:

@@ -106,8 +106,9 @@ class VelocityIk(ResolvedRate):
         repulsion = _limit_speed(self._repulsion(rows), 0.5 * limit)
         qdot = J_task @ v + (np.eye(robot.nq) - J_pinv @ J) @ repulsion
         self.iterations += 1
-        motion = _scale_into(self.dt * _limit_speed(qdot, limit), box[0] - q, box[1] - q,
-                             self._limits.last_motion)  # fmt: skip
+        motion = _scale_into(
+            self.dt * _limit_speed(qdot, limit), box[0] - q, box[1] - q, self._limits.last_motion
+        )
         return self._finish(q, q + motion, box, rows, t)
 
     def _repulsion(self, rows: ClearanceRows) -> np.ndarray:

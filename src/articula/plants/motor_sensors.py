@@ -24,11 +24,11 @@ class CurrentSensorParams(StrictModel):
     """
 
     ideal: bool = False
-    sensitivity: Positive = 0.185  # [V/A], ACS712-5A datasheet
-    zero_voltage: Positive = 2.5  # [V] output at 0 A
-    noise_pp: NonNegative = 0.021  # [V] peak-to-peak
+    sensitivity: Positive = 0.185
+    zero_voltage: Positive = 2.5
+    noise_pp: NonNegative = 0.021
     adc_bits: Annotated[int, Field(ge=1, le=24)] = 10
-    adc_vref: Positive = 5.0  # [V]
+    adc_vref: Positive = 5.0
 
     @model_validator(mode="after")
     def _zero_inside_adc_range(self) -> CurrentSensorParams:
@@ -55,7 +55,7 @@ class EncoderParams(StrictModel):
 
     ideal: bool = False
     counts_per_rev: Annotated[int, Field(ge=1, le=1_000_000_000)] = 375
-    window: Annotated[int, Field(ge=1, le=100_000)] = 50  # samples (50 ms at 1 kHz)
+    window: Annotated[int, Field(ge=1, le=100_000)] = 50
 
 
 @jit(error_model="numpy")

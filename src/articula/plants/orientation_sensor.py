@@ -24,8 +24,8 @@ class OrientationSensorParams(StrictModel):
     """
 
     ideal: bool = False
-    rate: Annotated[float, Field(gt=0, le=10_000, allow_inf_nan=False)] = 100.0  # [Hz]
-    noise_deg: NonNegative = 0.1  # [deg]
+    rate: Annotated[float, Field(gt=0, le=10_000, allow_inf_nan=False)] = 100.0
+    noise_deg: NonNegative = 0.1
 
 
 def euler_from_bend(beta: np.ndarray) -> np.ndarray:

@@ -46,29 +46,29 @@ class PneuNetParams(StrictModel):
     """
 
     # Valve switching period, Sect. 2.4.1.2: T = 1/30 s.
-    pwm_period: Positive = 1.0 / 30.0  # [s]
+    pwm_period: Positive = 1.0 / 30.0
     # Cheap solenoid valves need ~0.2 s to open or close fully: 3τ_v = 0.2 s.
-    valve_tau: Positive = 0.2 / 3.0  # [s]
+    valve_tau: Positive = 0.2 / 3.0
     # Supply pressure: PneuNets of Dragon Skin 10 are driven at a few tens of kPa.
-    supply_pressure: Positive = 50e3  # [Pa]
+    supply_pressure: Positive = 50e3
     # Chamber fill/vent time constant through the valve orifice; sets, with the valve lag, the
     # bandwidth (tracks 0.5 Hz, not 5 Hz, Sect. 2.4.2.2); calibrated, not measured.
-    chamber_tau: Positive = 0.25  # [s]
+    chamber_tau: Positive = 0.25
     # Saturating map θ_eq = θ_max (1 − exp(−p/p_c)): 90° at ~78 % of supply, ~100° at full.
-    theta_max: Positive = math.radians(120.0)  # [rad]
-    pressure_scale: Positive = 27.9e3  # [Pa] p_c
+    theta_max: Positive = math.radians(120.0)
+    pressure_scale: Positive = 27.9e3
     # Bending: a free PneuNet finger swings at a few Hz and its silicone damps it little.
-    natural_frequency: Positive = 2 * math.pi * 3.0  # [rad/s]
+    natural_frequency: Positive = 2 * math.pi * 3.0
     damping_ratio: Annotated[float, Field(gt=0, lt=1, allow_inf_nan=False)] = 0.15
     # Optional hysteresis: width of a play operator on the pressure (0: none).
-    hysteresis: NonNegative = 0.0  # [Pa]
+    hysteresis: NonNegative = 0.0
     # Flex sensor mapped linearly to volts (the book fits resistance to angle from data).
-    sensor_zero: NonNegative = 1.0  # [V] at 0°
-    sensor_gain: Positive = 2.5 / (math.pi / 2)  # [V/rad]: 2.5 V over 0-90°
+    sensor_zero: NonNegative = 1.0
+    sensor_gain: Positive = 2.5 / (math.pi / 2)
     # Flex-sensor dividers on an Arduino ADC wander by a couple of counts: σ ≈ 2 LSB ≈ 0.35°.
-    sensor_noise: NonNegative = math.radians(0.35)  # [rad] σ of the angle noise
-    adc_bits: Annotated[int, Field(ge=0, le=24)] = 10  # 0: no quantisation
-    adc_vref: Positive = 5.0  # [V]
+    sensor_noise: NonNegative = math.radians(0.35)
+    adc_bits: Annotated[int, Field(ge=0, le=24)] = 10
+    adc_vref: Positive = 5.0
     # Structural uncertainty between trials (the chapter's subject): the pump's pressure, the
     # chamber's fill time and the bending reach of each trial are scaled by 1 + spread·N(0, 1),
     # clipped to [0.5, 1.5]. Chosen as a plausible rig-to-rig drift, not fitted to the book.

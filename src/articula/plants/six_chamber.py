@@ -55,23 +55,23 @@ class SixChamberParams(StrictModel):
         stiffening: relative rise s of V E k² per chamber at full supply; 0: none.
     """
 
-    length: Positive = 0.10  # [m]
-    outer_radius: Positive = 0.04  # [m]
-    chamber_radius: Positive = 0.005  # [m]
-    chamber_circle: Positive = 0.025  # [m]
-    chamber_length: Positive = 0.09  # [m]
-    density: Positive = 1080.0  # [kg/m³]
-    sensor_mass: NonNegative = 0.02  # [kg] orientation sensor and its radio on the top
-    youngs_modulus: Positive = 17_390.0  # E [Pa], calibrated
-    damping: NonNegative = 2.162e-3  # b [N·m·s/rad], calibrated
-    supply: Positive = 100e3  # [Pa] gauge
-    atmosphere: Positive = 101_325.0  # [Pa] absolute
-    temperature: Positive = 293.15  # [K]
+    length: Positive = 0.10
+    outer_radius: Positive = 0.04
+    chamber_radius: Positive = 0.005
+    chamber_circle: Positive = 0.025
+    chamber_length: Positive = 0.09
+    density: Positive = 1080.0
+    sensor_mass: NonNegative = 0.02
+    youngs_modulus: Positive = 17_390.0
+    damping: NonNegative = 2.162e-3
+    supply: Positive = 100e3
+    atmosphere: Positive = 101_325.0
+    temperature: Positive = 293.15
     polytropic: Annotated[float, Field(ge=1.0, le=1.4, allow_inf_nan=False)] = 1.2
-    orifice_diameter: Positive = 1.0e-3  # [m]
+    orifice_diameter: Positive = 1.0e-3
     discharge: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.6
-    flow_transition: Positive = 500.0  # [Pa] below which orifice flow turns linear
-    stiffening: NonNegative = 0.0  # rise of V E k² per chamber at full supply (no book data)
+    flow_transition: Positive = 500.0
+    stiffening: NonNegative = 0.0
 
     @model_validator(mode="after")
     def _chambers_fit(self) -> SixChamberParams:

@@ -105,11 +105,21 @@ class Simulation:
 
 def _constants(p: SixChamberParams) -> np.ndarray:
     """Flat constants for the compiled right-hand side."""
-    return np.array([
-        p.inertia, p.stiffness, p.damping, p.chamber_volume, p.polytropic,
-        GAS_CONSTANT * p.temperature, p.discharge * p.orifice_area, p.flow_transition,
-        p.atmosphere, p.atmosphere + p.supply, p.stiffening / p.supply,
-    ])  # fmt: skip
+    return np.array(
+        [
+            p.inertia,
+            p.stiffness,
+            p.damping,
+            p.chamber_volume,
+            p.polytropic,
+            GAS_CONSTANT * p.temperature,
+            p.discharge * p.orifice_area,
+            p.flow_transition,
+            p.atmosphere,
+            p.atmosphere + p.supply,
+            p.stiffening / p.supply,
+        ]
+    )
 
 
 def integrate(
@@ -153,9 +163,18 @@ def integrate(
         )
     y0 = np.concatenate([beta0, rate0, np.full(CHAMBERS, p.atmosphere)])
     t, y, m = _integrate(
-        y0, modes, _constants(p), volume_gradients(p), schedule.times, schedule.chambers,
-        schedule.modes, schedule.targets + p.atmosphere, dt, steps, record_every,
-    )  # fmt: skip
+        y0,
+        modes,
+        _constants(p),
+        volume_gradients(p),
+        schedule.times,
+        schedule.chambers,
+        schedule.modes,
+        schedule.targets + p.atmosphere,
+        dt,
+        steps,
+        record_every,
+    )
     return Simulation(t, y[:, 0:2], y[:, 2:4], y[:, 4:] - p.atmosphere, m)
 
 
@@ -188,8 +207,9 @@ class Stepper:
         Args:
             modes: valve position of each chamber, shape (6,).
         """
-        _, ys, _ = _integrate(self.y, np.array(modes, np.int64), self._c, self._a, *self._none,
-                              self.dt, 1, 1)  # fmt: skip
+        _, ys, _ = _integrate(
+            self.y, np.array(modes, np.int64), self._c, self._a, *self._none, self.dt, 1, 1
+        )
         self.y = ys[-1]
 
 
@@ -247,9 +267,18 @@ def _rhs(
 
 @jit(error_model="numpy")
 def _integrate(
-    y0: np.ndarray, modes: np.ndarray, c: np.ndarray, a: np.ndarray, ev_t: np.ndarray,
-    ev_c: np.ndarray, ev_m: np.ndarray, ev_p: np.ndarray, dt: float, steps: int, every: int,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    y0: np.ndarray,
+    modes: np.ndarray,
+    c: np.ndarray,
+    a: np.ndarray,
+    ev_t: np.ndarray,
+    ev_c: np.ndarray,
+    ev_m: np.ndarray,
+    ev_p: np.ndarray,
+    dt: float,
+    steps: int,
+    every: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     n_rec = steps // every + 1
     ts = np.empty(n_rec)
     ys = np.empty((n_rec, y0.size))

@@ -36,26 +36,36 @@ def check_firmware(path: Path, program: str) -> None:
     if size == 0:
         raise ConfigError("--firmware", f"{path} is empty, not a firmware ELF; {fix}")
     if size > MAX_BYTES:
-        raise ConfigError("--firmware", f"{path} holds {size} bytes, more than any "
-                          f"ATmega2560 firmware ELF; {fix}")  # fmt: skip
+        raise ConfigError(
+            "--firmware", f"{path} holds {size} bytes, more than any ATmega2560 firmware ELF; {fix}"
+        )
     if data[:4] != b"\x7fELF":
-        raise ConfigError("--firmware", f"{path} is not an ELF file (it starts with "
-                          f"{data[:4].hex(' ')}); {fix}")  # fmt: skip
-    machine = struct.unpack_from("<H" if data[5:6] != b"\2" else ">H", data, 18)[0] \
-        if len(data) >= 20 else None  # fmt: skip
+        raise ConfigError(
+            "--firmware", f"{path} is not an ELF file (it starts with {data[:4].hex(' ')}); {fix}"
+        )
+    machine = (
+        struct.unpack_from("<H" if data[5:6] != b"\2" else ">H", data, 18)[0]
+        if len(data) >= 20
+        else None
+    )
     if machine is not None and machine != EM_AVR:
         name = MACHINES.get(machine, f"machine {machine}")
         raise ConfigError("--firmware", f"{path} is an ELF for {name}, not for the AVR; {fix}")
     if len(data) < 52 or data[4] != 1 or data[5] != 1:
-        raise ConfigError("--firmware", f"{path} is not a 32-bit little-endian ELF, as "
-                          f"avr-gcc makes; {fix}")  # fmt: skip
+        raise ConfigError(
+            "--firmware", f"{path} is not a 32-bit little-endian ELF, as avr-gcc makes; {fix}"
+        )
     found = _named_program(data)
     if found is None:
-        raise ConfigError("--firmware", f"{path} is an AVR ELF but not articula's rig "
-                          f"firmware (no {SECTION.decode()} section); {fix}")  # fmt: skip
+        raise ConfigError(
+            "--firmware",
+            f"{path} is an AVR ELF but not articula's rig "
+            f"firmware (no {SECTION.decode()} section); {fix}",
+        )
     if found != program:
-        raise ConfigError("--firmware", f"{path} is the {found} firmware, not the {program} "
-                          f"rig's; {fix}")  # fmt: skip
+        raise ConfigError(
+            "--firmware", f"{path} is the {found} firmware, not the {program} rig's; {fix}"
+        )
 
 
 def _named_program(data: bytes) -> str | None:
@@ -64,8 +74,7 @@ def _named_program(data: bytes) -> str | None:
     try:
         (shoff,) = struct.unpack_from("<I", data, 32)
         entsize, count, names = struct.unpack_from("<HHH", data, 46)
-        sections = [struct.unpack_from("<IIIIII", data, shoff + k * entsize)
-                    for k in range(count)]  # fmt: skip
+        sections = [struct.unpack_from("<IIIIII", data, shoff + k * entsize) for k in range(count)]
         table = sections[names]
         strings = data[table[4] : table[4] + table[5]]
         for name, _, _, _, offset, size in sections:

@@ -262,8 +262,11 @@ class Emulator:
         try:
             self._execute(frame)
         except (DeviceError, struct.error) as exc:
-            self._reply(Kind.ERROR, struct.pack("<HB", frame.seq, ErrorCode.BAD_VALUE)
-                       + str(exc).encode("ascii", "replace")[:200])  # fmt: skip
+            self._reply(
+                Kind.ERROR,
+                struct.pack("<HB", frame.seq, ErrorCode.BAD_VALUE)
+                + str(exc).encode("ascii", "replace")[:200],
+            )
 
     def _execute(self, frame: Frame) -> None:
         """Carry out one command and acknowledge it."""

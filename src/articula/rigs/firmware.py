@@ -24,8 +24,10 @@ from typing import NamedTuple, Protocol
 from articula.errors import ConfigError, DeviceError
 from articula.rigs.elf import check_firmware
 
-BUILD_HINT = "build it with: make -C firmware (needs apt-get install -y gcc-avr avr-libc " \
-    "simavr libsimavr-dev)"  # fmt: skip
+BUILD_HINT = (
+    "build it with: make -C firmware (needs apt-get install -y gcc-avr avr-libc "
+    "simavr libsimavr-dev)"
+)
 
 
 class Pins(NamedTuple):
@@ -45,15 +47,15 @@ class Pins(NamedTuple):
             main-loop control step (0 for a rig without one).
     """
 
-    adc_channel: int  # the channel the starting conversion reads (255: a tick, none)
-    porta: int  # port registers: direction and valve pins
+    adc_channel: int
+    porta: int
     portc: int
     porth: int
-    ocr1a: int  # PWM compare registers (duty counts)
+    ocr1a: int
     ocr3a: int
     ocr4a: int
-    step_cycles: int  # CPU cycles the previous control step took
-    step_latency: int  # from its sample's interrupt to the end of its control step
+    step_cycles: int
+    step_latency: int
 
 
 class Inputs(NamedTuple):
@@ -65,9 +67,9 @@ class Inputs(NamedTuple):
         serial1: the bytes a sensor sends on Serial1 now.
     """
 
-    adc_code: int = 0  # what the starting conversion reads
-    encoder_count: int = 0  # where the quadrature encoder on D2/D3 goes
-    serial1: bytes = b""  # what a sensor sends on Serial1 now
+    adc_code: int = 0
+    encoder_count: int = 0
+    serial1: bytes = b""
 
 
 class PinPlant(Protocol):
@@ -118,8 +120,9 @@ class FirmwareRig:
             raise ConfigError("--firmware", f"{elf} does not exist; {BUILD_HINT}")
         check_firmware(elf, plant.program)
         if not harness.is_file():
-            raise ConfigError("--firmware", f"{harness} does not exist beside {elf.name}; "
-                              f"{BUILD_HINT}")  # fmt: skip
+            raise ConfigError(
+                "--firmware", f"{harness} does not exist beside {elf.name}; {BUILD_HINT}"
+            )
         self.plant = plant
         self.step_cycles: list[int] = []  # per control period of the last run
         self.step_latency: list[int] = []
@@ -128,8 +131,9 @@ class FirmwareRig:
             args += ["--tick-us", str(plant.tick_us)]
         if trace is not None:
             args += ["--trace", str(trace)]
-        self._proc = subprocess.Popen(args, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                      text=True, bufsize=1)  # fmt: skip
+        self._proc = subprocess.Popen(
+            args, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, bufsize=1
+        )
         self.path = self._read_path()
         self._thread = threading.Thread(target=self._serve, name="articula-plant", daemon=True)
         self._thread.start()

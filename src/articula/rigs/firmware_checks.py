@@ -127,8 +127,11 @@ def stop_trial(
     run_at = max(c for what, c in trace.events if what == "run" and c <= stopped)
     safe = trace.safe_from(rig.plant.program, acked - 2 * period)
     failed = safe is None or safe > acked + period
-    return StopTrial(((stopped - run_at) % period) / period,
-                     np.inf if safe is None else (safe - acked) / CPU_HZ, failed)  # fmt: skip
+    return StopTrial(
+        ((stopped - run_at) % period) / period,
+        np.inf if safe is None else (safe - acked) / CPU_HZ,
+        failed,
+    )
 
 
 def host_loss_trial(
@@ -217,8 +220,12 @@ def traffic_trial(rig: FirmwareRig, trace: PinTrace, link: Link, bursts: int = 5
     link.command(Kind.START, struct.pack("<fI", LONG_RUN_S, 0), fresh=True)
     reference = link.setting(Kind.SET_REFERENCE)
     for _ in range(bursts):
-        for kind, body in ((Kind.STATUS, b""), (Kind.GET, bytes([Kind.SET_REFERENCE])),
-                           (Kind.SET_REFERENCE, reference), (Kind.STATUS, b"")):  # fmt: skip
+        for kind, body in (
+            (Kind.STATUS, b""),
+            (Kind.GET, bytes([Kind.SET_REFERENCE])),
+            (Kind.SET_REFERENCE, reference),
+            (Kind.STATUS, b""),
+        ):
             link.notify(kind, body)
         link.status()  # the burst answered: the next one
         link.inbox.clear()

@@ -113,8 +113,9 @@ class Link:
         retries: int = 3,
     ) -> None:
         try:
-            self.serial = serial.serial_for_url(port, baudrate=baud, timeout=0.02,
-                                                write_timeout=WRITE_TIMEOUT)  # fmt: skip
+            self.serial = serial.serial_for_url(
+                port, baudrate=baud, timeout=0.02, write_timeout=WRITE_TIMEOUT
+            )
         except (serial.SerialException, OSError, ValueError) as exc:
             raise PortError(f"{port}: cannot open the port ({exc})") from None
         self.port, self.timeout, self.retries = port, timeout, retries
@@ -146,11 +147,14 @@ class Link:
         except NoAnswerError as exc:
             raise PortError(str(exc)) from None
         if info.protocol != PROTOCOL_VERSION:
-            raise PortError(f"{self.port}: the device speaks protocol {info.protocol}, "
-                            f"articula {PROTOCOL_VERSION}; update its firmware")  # fmt: skip
+            raise PortError(
+                f"{self.port}: the device speaks protocol {info.protocol}, "
+                f"articula {PROTOCOL_VERSION}; update its firmware"
+            )
         if expect is not None and info.rig != expect:
-            raise PortError(f"{self.port}: a {info.rig.name.lower()} rig, not a "
-                            f"{expect.name.lower()} rig")  # fmt: skip
+            raise PortError(
+                f"{self.port}: a {info.rig.name.lower()} rig, not a {expect.name.lower()} rig"
+            )
         return info
 
     def command(self, kind: Kind, body: bytes = b"", fresh: bool = False) -> int:
@@ -190,8 +194,9 @@ class Link:
         """
         reply = self._exchange(Kind.STATUS, b"", answer=Kind.ACK)
         if len(reply.body) != 10:
-            raise DeviceError(f"{self.port}: a STATUS answer of {len(reply.body)} bytes; "
-                              "the protocol's is 10")  # fmt: skip
+            raise DeviceError(
+                f"{self.port}: a STATUS answer of {len(reply.body)} bytes; the protocol's is 10"
+            )
         running, samples, overruns, ended = struct.unpack_from("<BIHB", reply.body, 2)
         if ended not in RunEnd._value2member_map_:
             raise DeviceError(f"{self.port}: a STATUS answer with run end {ended}")
@@ -251,8 +256,10 @@ class Link:
                     return self._answered()
         finally:
             self._waiting = None
-        raise NoAnswerError(f"{self.port}: no answer to {kind.name} after {self.retries + 1} "
-                            f"tries; is the rig on and running articula's firmware?")  # fmt: skip
+        raise NoAnswerError(
+            f"{self.port}: no answer to {kind.name} after {self.retries + 1} "
+            f"tries; is the rig on and running articula's firmware?"
+        )
 
     def _answered(self) -> Frame:
         """The awaited answer; an ERROR naming the command raises DeviceError."""
@@ -266,8 +273,10 @@ class Link:
         try:
             self.serial.write(data)
         except serial.SerialTimeoutException:
-            raise DeviceError(f"{self.port}: the device took no bytes for {WRITE_TIMEOUT:g} s; "
-                              "it stopped reading the line") from None  # fmt: skip
+            raise DeviceError(
+                f"{self.port}: the device took no bytes for {WRITE_TIMEOUT:g} s; "
+                "it stopped reading the line"
+            ) from None
         except (serial.SerialException, OSError) as exc:
             raise DeviceError(f"{self.port}: the line went down ({exc})") from None
 
@@ -304,8 +313,7 @@ class Link:
                 return True
             if frame.seq == 0:  # a device that starts counts from 0 and says so
                 cause = protocol.decode_info(frame.body).reset
-                raise DeviceResetError(f"{self.port}: the device restarted "
-                                       f"({RESET_WORDS[cause]})")  # fmt: skip
+                raise DeviceResetError(f"{self.port}: the device restarted ({RESET_WORDS[cause]})")
             return False  # a late answer to a HELLO sent again
         if last is not None:
             self.stats.dropped += (frame.seq - last - 1) & 0xFFFF
@@ -318,8 +326,10 @@ class Link:
         if frame.kind == Kind.ACK or self.info is None:
             return False  # a late answer; or, before the handshake, an earlier session's
         if len(self.inbox) >= MAX_INBOX:
-            raise DeviceError(f"{self.port}: more than {MAX_INBOX} frames came that nothing "
-                              "asked for; the device floods the line")  # fmt: skip
+            raise DeviceError(
+                f"{self.port}: more than {MAX_INBOX} frames came that nothing "
+                "asked for; the device floods the line"
+            )
         self.inbox.append(frame)
         return True
 
@@ -329,15 +339,18 @@ class Link:
         kind = Kind(frame.kind).name if frame.kind in Kind._value2member_map_ else None
         if kind is None or frame.kind < 0x80:
             what = kind or f"type 0x{frame.kind:02x}"
-            raise DeviceError(f"{self.port}: the device sent a frame of {what} ({size} "
-                              "bytes), which no device sends")  # fmt: skip
+            raise DeviceError(
+                f"{self.port}: the device sent a frame of {what} ({size} "
+                "bytes), which no device sends"
+            )
         need = {Kind.ACK: (2, None), Kind.ERROR: (3, None), Kind.DONE: (6, 6)}.get(frame.kind)
         if frame.kind == Kind.TELEMETRY and self.info is not None:
             need = (4 + 4 * len(self.info.channels),) * 2
         if need is not None and (size < need[0] or (need[1] is not None and size > need[1])):
             exact = f"{need[0]}" if need[0] == need[1] else f"at least {need[0]}"
-            raise DeviceError(f"{self.port}: a {kind} frame of {size} bytes; the protocol's "
-                              f"has {exact} here")  # fmt: skip
+            raise DeviceError(
+                f"{self.port}: a {kind} frame of {size} bytes; the protocol's has {exact} here"
+            )
         if frame.kind == Kind.INFO:
             try:
                 protocol.decode_info(frame.body)

@@ -25,9 +25,15 @@ from articula.rigs.programs import Program, Shape
 from articula.rigs.protocol import PROTOCOL_VERSION, Channel, Info, Kind, RigKind
 
 FIRMWARE = (0, 2, 0)
-MEASURED = (Channel("i_ref", "A"), Channel("i_meas", "A"), Channel("i_fb", "A"),
-            Channel("omega_meas", "rad/s"), Channel("v1", "V"), Channel("duty1", "counts"),
-            Channel("v2", "V"))  # fmt: skip
+MEASURED = (
+    Channel("i_ref", "A"),
+    Channel("i_meas", "A"),
+    Channel("i_fb", "A"),
+    Channel("omega_meas", "rad/s"),
+    Channel("v1", "V"),
+    Channel("duty1", "counts"),
+    Channel("v2", "V"),
+)
 EMULATED = (Channel("i", "A"), Channel("omega", "rad/s"))  # the plant's truth: emulator only
 
 
@@ -43,11 +49,11 @@ class MotorGains:
         ki_speed: the load motor's speed-loop integral gain [V/rad].
     """
 
-    kp: float = 10.0  # [V/A]
-    ki: float = 100.0  # [V/(A·s)]
+    kp: float = 10.0
+    ki: float = 100.0
     filter_order: int = 1
-    kp_speed: float = 5.0  # [V·s/rad]
-    ki_speed: float = 10.0  # [V/rad]
+    kp_speed: float = 5.0
+    ki_speed: float = 10.0
 
     def encode(self) -> bytes:
         """SET_GAINS' body for the motor rig.
@@ -55,8 +61,7 @@ class MotorGains:
         Returns:
             kp, ki, filter_order, kp_speed, ki_speed as five float32 (20 bytes).
         """
-        return struct.pack("<5f", self.kp, self.ki, self.filter_order, self.kp_speed,
-                           self.ki_speed)  # fmt: skip
+        return struct.pack("<5f", self.kp, self.ki, self.filter_order, self.kp_speed, self.ki_speed)
 
     @classmethod
     def decode(cls, body: bytes) -> MotorGains:
@@ -206,15 +211,24 @@ class MotorPins:
             The current sensor's ADC code and the encoder's count at the new period's start.
         """
         if self._n > 0:
-            volts = [self._voltage(duty, pins.porta, bit) for duty, bit in
-                     zip((pins.ocr3a, pins.ocr4a), DIRECTION_BITS, strict=True)]  # fmt: skip
+            volts = [
+                self._voltage(duty, pins.porta, bit)
+                for duty, bit in zip((pins.ocr3a, pins.ocr4a), DIRECTION_BITS, strict=True)
+            ]
             self.x = self.Ad @ self.x + self.Bd @ np.array(volts)
         if self._n % NOISE_CHUNK == 0:
             self._noise = self._rng.standard_normal(NOISE_CHUNK)
         s = self.sensor
         i, omega, theta = self.x[I_PRIMARY], self.x[OMEGA], self.x[THETA]
-        code = adc_code(i, self._noise[self._n % NOISE_CHUNK], s.sensitivity, s.zero_voltage,
-                        s.noise_sigma, s.adc_bits, s.adc_vref)  # fmt: skip
+        code = adc_code(
+            i,
+            self._noise[self._n % NOISE_CHUNK],
+            s.sensitivity,
+            s.zero_voltage,
+            s.noise_sigma,
+            s.adc_bits,
+            s.adc_vref,
+        )
         self._n += 1
         self.trace.append((float(i), float(omega)))
         return Inputs(int(code), int(encoder_count(theta, self.counts_per_rev)))

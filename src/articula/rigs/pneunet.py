@@ -226,9 +226,12 @@ class PneuNetPins:
         built = PneuNetParams()
         for name in FIRMWARE_BUILD:
             if getattr(self.params, name) != getattr(built, name):
-                raise ConfigError(f"plant.{name}", f"the PneuNet firmware is built for "
-                                  f"{getattr(built, name):g}; change the config or "
-                                  "firmware/src/pneunet.c")  # fmt: skip
+                raise ConfigError(
+                    f"plant.{name}",
+                    f"the PneuNet firmware is built for "
+                    f"{getattr(built, name):g}; change the config or "
+                    "firmware/src/pneunet.c",
+                )
         self.start(0)
 
     def start(self, seed: int) -> None:

@@ -48,8 +48,9 @@ class Program:
     values: tuple[float, ...]
 
     def __post_init__(self) -> None:
-        need = {Shape.CONSTANT: 1, Shape.SINUSOID: 3, Shape.ACTUATION: 3,
-                Shape.CURRENT: 4}.get(self.shape)  # fmt: skip
+        need = {Shape.CONSTANT: 1, Shape.SINUSOID: 3, Shape.ACTUATION: 3, Shape.CURRENT: 4}.get(
+            self.shape
+        )
         if need is not None and len(self.values) != need:
             raise ConfigError("program", f"a {self.shape.name.lower()} takes {need} numbers")
         if self.shape == Shape.STEPS and not 2 <= len(self.values) <= MAX_VALUES:

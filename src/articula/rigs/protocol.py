@@ -234,8 +234,9 @@ def decode(frame: bytes) -> Frame:
     kind, seq = HEADER.unpack_from(payload)
     if len(payload) > MAX_FRAME:
         name = Kind(kind).name if kind in Kind._value2member_map_ else f"type 0x{kind:02x}"
-        raise DeviceError(f"a frame of {len(payload)} bytes ({name}), more than the "
-                          f"protocol's {MAX_FRAME}")  # fmt: skip
+        raise DeviceError(
+            f"a frame of {len(payload)} bytes ({name}), more than the protocol's {MAX_FRAME}"
+        )
     return Frame(kind, seq, payload[HEADER.size : -CRC.size])
 
 
@@ -313,8 +314,14 @@ def encode_info(info: Info) -> bytes:
     Returns:
         The message's body (docs/protocol.md).
     """
-    out = struct.pack("<BBBBBIB", info.protocol, info.rig, *info.firmware,
-                      info.sample_period_us, len(info.channels))  # fmt: skip
+    out = struct.pack(
+        "<BBBBBIB",
+        info.protocol,
+        info.rig,
+        *info.firmware,
+        info.sample_period_us,
+        len(info.channels),
+    )
     for channel in info.channels:
         for text in (channel.name, channel.unit):
             data = text.encode("ascii")

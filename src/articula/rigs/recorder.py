@@ -101,8 +101,9 @@ class Recorder:
             The run's record (record.json).
         """
         self._journal.close()
-        record = build_record(self.config, Result(dict(metrics), {}),
-                              time.monotonic() - self._started)  # fmt: skip
+        record = build_record(
+            self.config, Result(dict(metrics), {}), time.monotonic() - self._started
+        )
         record["complete"] = incomplete is None
         if incomplete is not None:
             record["incomplete"] = incomplete

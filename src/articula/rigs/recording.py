@@ -51,9 +51,12 @@ def _pneunet_gains(body: bytes) -> dict[str, Any]:
     """The PneuNet's SET_GAINS body, readable."""
     schedule = decode_gains(body)
     points = np.broadcast_to(schedule.points, (len(schedule.gains),))
-    return {"schedule": schedule.kind,
-            "rows": [[*map(float, row), float(p)] for row, p in zip(schedule.gains, points,
-                                                                    strict=True)]}  # fmt: skip
+    return {
+        "schedule": schedule.kind,
+        "rows": [
+            [*map(float, row), float(p)] for row, p in zip(schedule.gains, points, strict=True)
+        ],
+    }
 
 
 def _pneunet_gains_body(table: Mapping[str, Any]) -> bytes:
@@ -68,8 +71,10 @@ def _pneunet_gains_body(table: Mapping[str, Any]) -> bytes:
 def _floats(names: tuple[str, ...]) -> tuple[Callable[[bytes], dict], Callable[[Mapping], bytes]]:
     """A setting of named float32s: (body to table, table to body)."""
     form = f"<{len(names)}f"
-    return (lambda body: dict(zip(names, map(float, struct.unpack(form, body)), strict=True)),
-            lambda table: struct.pack(form, *(float(table[n]) for n in names)))  # fmt: skip
+    return (
+        lambda body: dict(zip(names, map(float, struct.unpack(form, body)), strict=True)),
+        lambda table: struct.pack(form, *(float(table[n]) for n in names)),
+    )
 
 
 def _output(body: bytes) -> dict[str, Any] | None:
@@ -114,8 +119,13 @@ def recording_config(link: Link, duration: float, seed: int) -> dict[str, Any]:
         if table is not None:
             settings[name] = table
     words = {kind: word for word, kind in RIGS.items()}
-    return {"experiment": EXPERIMENT, "rig": words[rig], "duration": duration, "seed": seed,
-            "settings": settings}  # fmt: skip
+    return {
+        "experiment": EXPERIMENT,
+        "rig": words[rig],
+        "duration": duration,
+        "seed": seed,
+        "settings": settings,
+    }
 
 
 def parse_recording(data: Mapping[str, Any], where: str) -> dict[str, Any]:
@@ -130,8 +140,10 @@ def parse_recording(data: Mapping[str, Any], where: str) -> dict[str, Any]:
     """
     unknown = set(data) - {"experiment", "rig", "duration", "seed", "settings"}
     if unknown:
-        raise ConfigError(f"{where}: {sorted(unknown)[0]}", "unknown key; a rig.record config "
-                          "has rig, duration, seed and [settings]")  # fmt: skip
+        raise ConfigError(
+            f"{where}: {sorted(unknown)[0]}",
+            "unknown key; a rig.record config has rig, duration, seed and [settings]",
+        )
     if data.get("rig") not in RIGS:
         raise ConfigError(f"{where}: rig", f"one of {', '.join(RIGS)}")
     duration, seed = data.get("duration"), data.get("seed", 0)
@@ -143,8 +155,10 @@ def parse_recording(data: Mapping[str, Any], where: str) -> dict[str, Any]:
     bodies = []
     for name, table in dict(data.get("settings", {})).items():
         if name not in CODECS[rig]:
-            raise ConfigError(f"{where}: settings.{name}", f"a {data['rig']} rig's settings are "
-                              f"{', '.join(CODECS[rig])}")  # fmt: skip
+            raise ConfigError(
+                f"{where}: settings.{name}",
+                f"a {data['rig']} rig's settings are {', '.join(CODECS[rig])}",
+            )
         kind, _, body = CODECS[rig][name]
         try:
             bodies.append((kind, body(table)))

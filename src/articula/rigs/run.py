@@ -84,8 +84,9 @@ def run_program(
     period = link.info.sample_period_us * 1e-6
     most = math.floor(duration / period + 1e-6) + 2  # samples a run of `duration` can have
     link.command(Kind.STREAM, struct.pack("<H", 1))
-    start = link.command(Kind.START, struct.pack("<fIH", duration, seed & 0xFFFFFFFF,
-                                                 host_timeout_ms), fresh=True)  # fmt: skip
+    start = link.command(
+        Kind.START, struct.pack("<fIH", duration, seed & 0xFFFFFFFF, host_timeout_ms), fresh=True
+    )
     deadline = time.monotonic() + duration + margin
     beat = min(HEARTBEAT_S, host_timeout_ms / 5000)
     clock, times, rows = DeviceClock(), [], []
@@ -96,17 +97,20 @@ def run_program(
         if frame.kind == Kind.TELEMETRY:
             t = clock.seconds(struct.unpack_from("<I", frame.body)[0])
             if len(times) >= most or t > duration + period:
-                raise DeviceError(f"{link.port}: sample {len(times) + 1} came at {t:g} s of a "
-                                  f"{duration:g} s run with a sample every {period:g} s; the "
-                                  "device sends more than the run has")  # fmt: skip
+                raise DeviceError(
+                    f"{link.port}: sample {len(times) + 1} came at {t:g} s of a "
+                    f"{duration:g} s run with a sample every {period:g} s; the "
+                    "device sends more than the run has"
+                )
             times.append(t)
             rows.append(unpack_floats(frame.body, channels, 4))
             if on_sample is not None:
                 on_sample(times[-1], rows[-1])
         elif frame.kind == Kind.ERROR and int.from_bytes(frame.body[:2], "little") == start:
             text = frame.body[3:].decode("ascii", "replace")
-            raise DeviceError(f"{link.port}: the rig stopped the run: {text} "
-                              f"(code {frame.body[2]})")  # fmt: skip
+            raise DeviceError(
+                f"{link.port}: the rig stopped the run: {text} (code {frame.body[2]})"
+            )
         return frame.kind == Kind.DONE and int.from_bytes(frame.body[:2], "little") == start
 
     try:
@@ -114,9 +118,11 @@ def run_program(
         while not ended:
             now = time.monotonic()
             if now > deadline:
-                raise DeviceError(f"{link.port}: the run of {duration:g} s did not end within "
-                                  f"{duration + margin:g} s ({len(times)} samples came); the "
-                                  "device keeps running")  # fmt: skip
+                raise DeviceError(
+                    f"{link.port}: the run of {duration:g} s did not end within "
+                    f"{duration + margin:g} s ({len(times)} samples came); the "
+                    "device keeps running"
+                )
             if now >= due:  # the heartbeat; it also tells when DONE was lost on the way
                 status = link.status()
                 due = time.monotonic() + beat
@@ -124,8 +130,10 @@ def run_program(
                     while link.inbox and not ended:  # what came before the answer
                         ended = take(link.inbox.popleft())
                     if not ended and status.ended not in (RunEnd.DONE, RunEnd.NOT_ENDED):
-                        raise DeviceError(f"{link.port}: the rig ended the run early "
-                                          f"({status.ended.name.lower()})")  # fmt: skip
+                        raise DeviceError(
+                            f"{link.port}: the rig ended the run early "
+                            f"({status.ended.name.lower()})"
+                        )
                     ended = True
                 continue
             frame = link.next_frame(min(due, deadline) - now)

@@ -64,8 +64,17 @@ class SixChamberDevice(PlayedRun):
         self.damping = DampingPolicy()
         # The plant's compiled code loads (or compiles) now, not while a host waits on a run.
         program = valve_program(self.actuator, 0.0, 1.0, 0.01, self.damping)
-        deactuate(self.actuator, self.sensor, program, 0.0, 0.01, 0.01, STEP, RECORD_EVERY,
-                  np.random.default_rng(0))  # fmt: skip
+        deactuate(
+            self.actuator,
+            self.sensor,
+            program,
+            0.0,
+            0.01,
+            0.01,
+            STEP,
+            RECORD_EVERY,
+            np.random.default_rng(0),
+        )
 
     def configure(self, kind: int, body: bytes) -> None:
         """Take SET_REFERENCE (an actuation program) or SET_DAMPING.
@@ -119,8 +128,17 @@ class SixChamberDevice(PlayedRun):
 
         def run() -> np.ndarray:
             program = valve_program(self.actuator, side, gauge, hold, self.damping)
-            done = deactuate(self.actuator, self.sensor, program, side, hold, duration - hold,
-                             STEP, RECORD_EVERY, np.random.default_rng(seed))  # fmt: skip
+            done = deactuate(
+                self.actuator,
+                self.sensor,
+                program,
+                side,
+                hold,
+                duration - hold,
+                STEP,
+                RECORD_EVERY,
+                np.random.default_rng(seed),
+            )
             return np.degrees(done.sensor_bend)  # (bend_x, bend_y) [deg] per sensor sample
 
         self._begin(run)
@@ -174,8 +192,14 @@ static const float fill_seconds[FILL_STEPS + 1] PROGMEM = {{
 SENSOR_FRAME = b"\xa5\x5a"  # then roll, pitch, yaw float32 [deg] and their bytes' sum
 # The firmware's valve coils (firmware/src/six_chamber.c): chamber i's (port, fill bit, vent
 # bit); D22-D29 are PA0-PA7, D30-D33 are PC7-PC4.
-COILS = (("porta", 0, 1), ("porta", 2, 3), ("porta", 4, 5), ("porta", 6, 7),
-         ("portc", 7, 6), ("portc", 5, 4))  # fmt: skip
+COILS = (
+    ("porta", 0, 1),
+    ("porta", 2, 3),
+    ("porta", 4, 5),
+    ("porta", 6, 7),
+    ("portc", 7, 6),
+    ("portc", 5, 4),
+)
 
 
 class SixChamberPins:
@@ -201,12 +225,16 @@ class SixChamberPins:
         self.actuator = actuator or SixChamberParams()
         self.sensor = sensor or OrientationSensorParams()
         if self.actuator != SixChamberParams():
-            raise ConfigError("actuator", "the six-chamber firmware's fill_table.h is the "
-                              "default actuator's; regenerate it (tools/fill_table.py) for "
-                              "another")  # fmt: skip
+            raise ConfigError(
+                "actuator",
+                "the six-chamber firmware's fill_table.h is the "
+                "default actuator's; regenerate it (tools/fill_table.py) for "
+                "another",
+            )
         if self.sensor.rate != 100.0:
-            raise ConfigError("sensor.rate", f"the firmware reads a 100 Hz sensor (got "
-                              f"{self.sensor.rate:g} Hz)")  # fmt: skip
+            raise ConfigError(
+                "sensor.rate", f"the firmware reads a 100 Hz sensor (got {self.sensor.rate:g} Hz)"
+            )
         # The model's compiled code loads (or compiles) now, not while the firmware waits.
         self.start(0)
         self.period(Pins(255, 0, 0, 0, 0, 0, 0, 0, 0))

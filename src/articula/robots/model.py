@@ -62,7 +62,7 @@ class LinkGeometry:
     name: str
     frame_id: int
     shapes: tuple[ConvexShape, ...]
-    placements: tuple[np.ndarray, ...]  # pose of each shape in the link frame (4×4)
+    placements: tuple[np.ndarray, ...]
 
 
 class RobotModel:
@@ -236,8 +236,10 @@ class RobotModel:
     def sample_range(self) -> tuple[np.ndarray, np.ndarray]:
         """(lower, upper) ends of the range joint values are drawn from [rad or m]: the limits,
         or ±π for a continuous joint."""
-        return (np.where(self.continuous, -np.pi, self.model.lowerPositionLimit),
-                np.where(self.continuous, np.pi, self.model.upperPositionLimit))  # fmt: skip
+        return (
+            np.where(self.continuous, -np.pi, self.model.lowerPositionLimit),
+            np.where(self.continuous, np.pi, self.model.upperPositionLimit),
+        )
 
     @property
     def velocity_limit(self) -> np.ndarray:
@@ -254,8 +256,9 @@ class RobotModel:
         Returns:
             The clipped joint positions, shape (nq,) [rad or m].
         """
-        return np.minimum(np.maximum(q, self.model.lowerPositionLimit),
-                          self.model.upperPositionLimit)  # fmt: skip
+        return np.minimum(
+            np.maximum(q, self.model.lowerPositionLimit), self.model.upperPositionLimit
+        )
 
     def wrap(self, q: np.ndarray) -> np.ndarray:
         """q with each continuous joint's value wrapped to (−π, π] (the others as they are).

@@ -102,9 +102,12 @@ def _execute_dask(
     cluster = None
     if address == "local":
         cluster = LocalCluster(
-            n_workers=max(workers, 1), threads_per_worker=1, host="127.0.0.1",
-            dashboard_address=None, processes=True,
-        )  # fmt: skip
+            n_workers=max(workers, 1),
+            threads_per_worker=1,
+            host="127.0.0.1",
+            dashboard_address=None,
+            processes=True,
+        )
         client = Client(cluster)
     else:
         try:

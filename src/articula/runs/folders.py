@@ -101,8 +101,11 @@ def check_out(folder: Path, kind: Kind, force: bool = False, option: str = "--ou
     if not folder.exists():
         parent = next((p for p in folder.parents if p.exists()), None)
         if parent is not None and not parent.is_dir():
-            raise ConfigError(option, f"{_shown(parent)} is a file, so {_shown(folder)} cannot "
-                                       "be created; give a folder path")  # fmt: skip
+            raise ConfigError(
+                option,
+                f"{_shown(parent)} is a file, so {_shown(folder)} cannot "
+                "be created; give a folder path",
+            )
         return
     if force:
         return

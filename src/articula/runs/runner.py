@@ -170,8 +170,9 @@ def run_sweep(
     configs = [normalized(c) for c in configs]
     with claimed(out, "sweep", force):
         hashes = [records.config_hash(c) for c in configs]
-        todo = [c for c, h in zip(configs, hashes, strict=True)
-                if not records.is_finished(out / h, h)]  # fmt: skip
+        todo = [
+            c for c, h in zip(configs, hashes, strict=True) if not records.is_finished(out / h, h)
+        ]
         done = len(configs) - len(todo)
         if progress:
             progress(done, len(configs))

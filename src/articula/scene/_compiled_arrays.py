@@ -15,10 +15,12 @@ def _reach(placements: list, poses: list[np.ndarray], cores: list) -> float:
     that plus its own extent."""
     chain = float(sum(np.linalg.norm(p.translation) for p in placements))
     extent = max(
-        (np.linalg.norm(T[:3, 3]) + float(np.max(np.linalg.norm(core[0], axis=1))) + core[1]
-         for T, core in zip(poses, cores, strict=True)),
+        (
+            np.linalg.norm(T[:3, 3]) + float(np.max(np.linalg.norm(core[0], axis=1))) + core[1]
+            for T, core in zip(poses, cores, strict=True)
+        ),
         default=0.0,
-    )  # fmt: skip
+    )
     return 2.0 * chain + extent
 
 

@@ -62,15 +62,17 @@ class _PairDistances:
             return [self._vertex_distance(p) for p in range(n)]
         if every_pair and self.broadphase and within < np.inf:
             lower = self._lower_bounds(q, t)
-            pin.updateGeometryPlacements(self.robot.model, self.robot.data, self._geo.exact,
-                                         self._exact_data)  # fmt: skip
+            pin.updateGeometryPlacements(
+                self.robot.model, self.robot.data, self._geo.exact, self._exact_data
+            )
             return [self._exact(p) if lower[p] < within else np.inf for p in range(n)]
         if every_pair or not self.broadphase:
             self._place(q, t)
             return [self._exact(p) for p in range(n)]
         lower = self._lower_bounds(q, t)
-        pin.updateGeometryPlacements(self.robot.model, self.robot.data, self._geo.exact,
-                                     self._exact_data)  # fmt: skip
+        pin.updateGeometryPlacements(
+            self.robot.model, self.robot.data, self._geo.exact, self._exact_data
+        )
         out = [np.inf] * n
         cell_best: dict[tuple[int, int], float] = {}
         for p in sorted(range(n), key=lower.__getitem__):
@@ -86,8 +88,9 @@ class _PairDistances:
         static pairs, which the bounds model skips); also runs the forward kinematics that the
         exact placements then reuse."""
         self._move_obstacles(t)
-        pin.computeDistances(self.robot.model, self.robot.data, self._geo.bounds,
-                             self._bounds_data, q)  # fmt: skip
+        pin.computeDistances(
+            self.robot.model, self.robot.data, self._geo.bounds, self._bounds_data, q
+        )
         lower = [-np.inf] * len(self._bound_results)  # static pairs: no bound, always exact
         for p, r in zip(self._dynamic, self._dynamic_bounds, strict=True):
             lower[p] = r.min_distance

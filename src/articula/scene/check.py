@@ -104,8 +104,11 @@ def check_scene(
         itself = Scene(scene.robot, [], metric=scene.metric, self_pairs=checked)
     if q_file is not None:
         rows = read_q_file(q_file, scene.robot.nq)
-        return {"configurations": [_check(scene, itself, scene.robot.check_q(q, "--q-file"),
-                                          metric) for q in rows]}  # fmt: skip
+        return {
+            "configurations": [
+                _check(scene, itself, scene.robot.check_q(q, "--q-file"), metric) for q in rows
+            ]
+        }
     q = q0 if q_text is None else scene.robot.check_q(parse_q(q_text), "--q")
     return _check(scene, itself, q, metric)
 

@@ -78,35 +78,35 @@ class CompiledClearance:
         moving_parts: (shape index, its obstacle) of each part of a moving obstacle.
     """
 
-    parents: np.ndarray  # (joints,) parent joint index; joint 0 is the world
-    joint_rot: np.ndarray  # (joints, 3, 3) joint placement in the parent joint frame
-    joint_p: np.ndarray  # (joints, 3)
-    axes: np.ndarray  # (joints, 3) revolute axis in the joint frame
-    q_index: np.ndarray  # (joints,) index of the joint's angle in q
+    parents: np.ndarray
+    joint_rot: np.ndarray
+    joint_p: np.ndarray
+    axes: np.ndarray
+    q_index: np.ndarray
     ee_joint: int
-    ee_p: np.ndarray  # end-effector origin in its joint frame
-    ee_rot: np.ndarray  # end-effector orientation in its joint frame (3×3)
-    vertices: np.ndarray  # (total, 3) cores of every shape in their own frame, concatenated
-    starts: np.ndarray  # (shapes + 1,) offsets into vertices
-    neighbours: np.ndarray  # vertices joined by a hull edge, CSR by vertex (global indices)
-    offsets: np.ndarray  # (total + 1,)
-    hints: np.ndarray  # (shapes,) where each support search starts (mutable scratch)
-    simplices: np.ndarray  # (pairs, 7) each pair's GJK warm start (gjk.py; mutable scratch)
-    memory: np.ndarray  # (pairs, 25) last exact distance, then the two shapes' poses (R, p)
+    ee_p: np.ndarray
+    ee_rot: np.ndarray
+    vertices: np.ndarray
+    starts: np.ndarray
+    neighbours: np.ndarray
+    offsets: np.ndarray
+    hints: np.ndarray
+    simplices: np.ndarray
+    memory: np.ndarray
     # at that time (mutable scratch; distance −inf: none yet)
-    extents: np.ndarray  # (shapes,) largest |x| of a core vertex in the shape's frame [m]
-    radii: np.ndarray  # (shapes,)
-    shape_joint: np.ndarray  # (shapes,) joint a shape moves with (0: the world)
-    shape_rot: np.ndarray  # (shapes, 3, 3) shape pose in its joint frame (world for obstacles)
-    shape_p: np.ndarray  # (shapes, 3)
-    capsule_a: np.ndarray  # (shapes, 3) ends of each bounding capsule, in the shape's frame
+    extents: np.ndarray
+    radii: np.ndarray
+    shape_joint: np.ndarray
+    shape_rot: np.ndarray
+    shape_p: np.ndarray
+    capsule_a: np.ndarray
     capsule_b: np.ndarray
     capsule_r: np.ndarray
-    pairs: np.ndarray  # (pairs, 5) (shape, shape, cache row, OBSTACLE | SELF, cell) that move
-    cells: int  # (link, obstacle) cells, row-major, then the checked link pairs in scene order
-    static_min: np.ndarray  # (2,) smallest distance of the pairs that never move, per kind
-    reach: float  # [m] no shape point is farther than this from any joint origin, in any pose
-    moving_parts: tuple[tuple[int, object], ...] = ()  # (shape, its obstacle) that move
+    pairs: np.ndarray
+    cells: int
+    static_min: np.ndarray
+    reach: float
+    moving_parts: tuple[tuple[int, object], ...] = ()
     _selected: dict = field(default_factory=dict, repr=False)  # select's answers, by kinds
 
     @classmethod

@@ -46,7 +46,7 @@ def _rotate_about(R: np.ndarray, axis: np.ndarray, angle: float, out: np.ndarray
 
 
 @jit()
-def _turn_columns(R, i, j, k, c, s, out):  # fmt: skip
+def _turn_columns(R, i, j, k, c, s, out):
     """out = R · Rot(e_k, angle) for the coordinate axis e_k, (i, j, k) a cyclic order:
     columns i and j turn by (c, s) = (cos, sin) of the angle, column k stays."""
     for m in range(3):
@@ -97,7 +97,7 @@ def _segment_distance(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.nda
 
 
 @jit()
-def _joint_poses(q, parents, joint_rot, joint_p, axes, q_index):  # fmt: skip
+def _joint_poses(q, parents, joint_rot, joint_p, axes, q_index):
     """World rotation and origin of every joint frame at q (joint 0: the world)."""
     nj = parents.size
     oR = np.empty((nj, 3, 3))
@@ -113,7 +113,7 @@ def _joint_poses(q, parents, joint_rot, joint_p, axes, q_index):  # fmt: skip
 
 
 @jit()
-def _ee_pose(oR, op, ee_joint, ee_p, ee_rot):  # fmt: skip
+def _ee_pose(oR, op, ee_joint, ee_p, ee_rot):
     """The end effector's world position and rotation from its joint's pose and its
     placement (ee_rot, ee_p) in that joint's frame."""
     ee = np.empty(3)
@@ -124,8 +124,9 @@ def _ee_pose(oR, op, ee_joint, ee_p, ee_rot):  # fmt: skip
 
 
 @jit()
-def _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a, capsule_b, pairs,
-                 ends_too=True):  # fmt: skip
+def _shape_poses(
+    oR, op, shape_joint, shape_rot, shape_p, capsule_a, capsule_b, pairs, ends_too=True
+):
     """World pose of every shape of `pairs` and (with ends_too; else unset, see _place_ends)
     the ends of its bounding capsule's segment (the other shapes' rows are left unset: a far
     obstacle costs nothing here)."""
@@ -146,14 +147,14 @@ def _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a, capsule_b, 
 
 
 @jit()
-def _place_ends(s, world_R, world_p, capsule_a, capsule_b, ends):  # fmt: skip
+def _place_ends(s, world_R, world_p, capsule_a, capsule_b, ends):
     """ends[s] = the world ends of shape s's bounding capsule segment."""
     _apply(world_R[s], world_p[s], capsule_a[s], ends[s, 0])
     _apply(world_R[s], world_p[s], capsule_b[s], ends[s, 1])
 
 
 @jit()
-def _capsule_gaps(ends, capsule_r, pairs):  # fmt: skip
+def _capsule_gaps(ends, capsule_r, pairs):
     """Capsule-capsule distance of every pair: a lower bound of its exact distance."""
     lower = np.empty(pairs.shape[0])
     for k in range(pairs.shape[0]):
@@ -164,7 +165,7 @@ def _capsule_gaps(ends, capsule_r, pairs):  # fmt: skip
 
 
 @jit()
-def _moved(memory, row, at, world_R, world_p, s, extent):  # fmt: skip
+def _moved(memory, row, at, world_R, world_p, s, extent):
     """A bound [m] on how far any point within `extent` of shape s's origin moved from the
     pose (R0, p0) stored in memory[row, at:at + 12] (R0 row-major, then p0) to its pose now,
     (world_R[s], world_p[s]): |p − p0| + ||R − R0||₂ extent, ||R − R0||₂ = √(3 − tr(R0ᵀ R)).
@@ -180,7 +181,7 @@ def _moved(memory, row, at, world_R, world_p, s, extent):  # fmt: skip
 
 
 @jit()
-def _remembered_bound(memory, row, a, b, world_R, world_p, extents, shape_joint):  # fmt: skip
+def _remembered_bound(memory, row, a, b, world_R, world_p, extents, shape_joint):
     """The last lower bound of a pair (memory[row]: an exact distance or a capsule gap) less
     how far its shapes a and b moved since: a lower bound of its distance now (−inf before
     the first). A shape on joint 0 (an obstacle) has not moved: CompiledClearance.at charges
@@ -194,7 +195,7 @@ def _remembered_bound(memory, row, a, b, world_R, world_p, extents, shape_joint)
 
 
 @jit()
-def _remember(memory, d, R_a, p_a, R_b, p_b):  # fmt: skip
+def _remember(memory, d, R_a, p_a, R_b, p_b):
     """Store a lower bound d [m] of a pair's distance and the poses of its shapes it holds at."""
     memory[0] = d
     memory[1:10] = R_a.ravel()

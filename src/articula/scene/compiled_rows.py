@@ -50,15 +50,39 @@ def clearance_rows(
         shape (rows, nq) [m/rad]; link-pair flags, shape (rows,) bool), or None on an overlap.
     """
     c = compiled
-    out = _rows(q, c.parents, c.joint_rot, c.joint_p, c.axes, c.q_index, c.ee_joint, c.ee_p,
-                c.ee_rot, c.vertices, c.starts, c.neighbours, c.offsets, c.hints, c.simplices,
-                c.radii, c.shape_joint, c.shape_rot, c.shape_p, c.capsule_a, c.capsule_b,
-                c.capsule_r, c.pairs, c.cells, influence, q.size)  # fmt: skip
+    out = _rows(
+        q,
+        c.parents,
+        c.joint_rot,
+        c.joint_p,
+        c.axes,
+        c.q_index,
+        c.ee_joint,
+        c.ee_p,
+        c.ee_rot,
+        c.vertices,
+        c.starts,
+        c.neighbours,
+        c.offsets,
+        c.hints,
+        c.simplices,
+        c.radii,
+        c.shape_joint,
+        c.shape_rot,
+        c.shape_p,
+        c.capsule_a,
+        c.capsule_b,
+        c.capsule_r,
+        c.pairs,
+        c.cells,
+        influence,
+        q.size,
+    )
     return None if out[6] else out[:6]
 
 
 @jit()
-def _lever(oR, op, axes, parents, q_index, joint, point, normal, sign, row):  # fmt: skip
+def _lever(oR, op, axes, parents, q_index, joint, point, normal, sign, row):
     """row += sign · n·(∂point/∂q): for each revolute joint k above `joint`, the world axis
     a_k and origin o_k give n·(a_k × (p − o_k)) = a_k · ((p − o_k) × n)."""
     k = joint
@@ -76,7 +100,7 @@ def _lever(oR, op, axes, parents, q_index, joint, point, normal, sign, row):  # 
 
 
 @jit()
-def _jacobian(oR, op, axes, parents, q_index, joint, point, nq):  # fmt: skip
+def _jacobian(oR, op, axes, parents, q_index, joint, point, nq):
     """The 6 × nq world-axes Jacobian of a point moving with `joint`: (a_k × (p − o_k); a_k)."""
     J = np.zeros((6, nq))
     k = joint
@@ -94,16 +118,40 @@ def _jacobian(oR, op, axes, parents, q_index, joint, point, nq):  # fmt: skip
 
 @jit()
 def _rows(
-    q, parents, joint_rot, joint_p, axes, q_index, ee_joint, ee_p, ee_rot, vertices, starts,
-    neighbours, offsets, hints, simplices, radii, shape_joint, shape_rot, shape_p, capsule_a,
-    capsule_b, capsule_r, pairs, cells, influence, nq,
-):  # fmt: skip
+    q,
+    parents,
+    joint_rot,
+    joint_p,
+    axes,
+    q_index,
+    ee_joint,
+    ee_p,
+    ee_rot,
+    vertices,
+    starts,
+    neighbours,
+    offsets,
+    hints,
+    simplices,
+    radii,
+    shape_joint,
+    shape_rot,
+    shape_p,
+    capsule_a,
+    capsule_b,
+    capsule_r,
+    pairs,
+    cells,
+    influence,
+    nq,
+):
     """clearance_rows in one compiled call; the last item flags an overlap."""
     oR, op = _joint_poses(q, parents, joint_rot, joint_p, axes, q_index)
     ee, ee_R = _ee_pose(oR, op, ee_joint, ee_p, ee_rot)
     J = _jacobian(oR, op, axes, parents, q_index, ee_joint, ee, nq)
-    world_R, world_p, ends = _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a,
-                                          capsule_b, pairs)  # fmt: skip
+    world_R, world_p, ends = _shape_poses(
+        oR, op, shape_joint, shape_rot, shape_p, capsule_a, capsule_b, pairs
+    )
     lower = _capsule_gaps(ends, capsule_r, pairs)
     best = np.full(cells, np.inf)
     on_a = np.zeros((cells, 3))
@@ -118,10 +166,23 @@ def _rows(
         if lower[k] >= influence or lower[k] >= best[cell]:
             continue  # the capsules already rule it out
         a, b = pairs[k, 0], pairs[k, 1]
-        d = gjk_witnesses(vertices, neighbours, offsets, hints,
-                          a, world_R[a], world_p[a], radii[a],
-                          b, world_R[b], world_p[b], radii[b], simplices[pairs[k, 2]],
-                          point_a, point_b)  # fmt: skip
+        d = gjk_witnesses(
+            vertices,
+            neighbours,
+            offsets,
+            hints,
+            a,
+            world_R[a],
+            world_p[a],
+            radii[a],
+            b,
+            world_R[b],
+            world_p[b],
+            radii[b],
+            simplices[pairs[k, 2]],
+            point_a,
+            point_b,
+        )
         if d <= 0.0:
             return ee, ee_R, J, np.zeros(0), np.zeros((0, nq)), np.zeros(0, np.bool_), True
         if d < best[cell]:
@@ -143,10 +204,21 @@ def _rows(
         for i in range(3):
             normal[i] = gap[i] / length
         row = gradient[count]
-        _lever(oR, op, axes, parents, q_index, shape_joint[shape_a[cell]], on_a[cell], normal,
-               1.0, row)  # fmt: skip
-        _lever(oR, op, axes, parents, q_index, shape_joint[shape_b[cell]], on_b[cell], normal,
-               -1.0, row)  # fmt: skip
+        _lever(
+            oR, op, axes, parents, q_index, shape_joint[shape_a[cell]], on_a[cell], normal, 1.0, row
+        )
+        _lever(
+            oR,
+            op,
+            axes,
+            parents,
+            q_index,
+            shape_joint[shape_b[cell]],
+            on_b[cell],
+            normal,
+            -1.0,
+            row,
+        )
         moving = False
         for i in range(nq):
             if row[i] != 0.0:

@@ -86,9 +86,9 @@ class RobotSpec(StrictModel):
     package_dirs: list[str] = Field(default_factory=list)
     ee_frame: str | None = None
     ee_offset: EeOffsetSpec | None = None
-    locked_joints: dict[str, Radians] = Field(default_factory=dict)  # joint -> [rad or m]
+    locked_joints: dict[str, Radians] = Field(default_factory=dict)
     q0: list[Radians] | None = None
-    max_links: Annotated[int, Field(ge=1, le=100_000)] = MAX_LINKS  # refuse larger URDFs
+    max_links: Annotated[int, Field(ge=1, le=100_000)] = MAX_LINKS
     # Link meshes CoACD decomposes (true: all; or link names) instead of one hull per part:
     # a non-convex link keeps its concavities, so clearance is not under-stated there.
     decompose: bool | list[str] = False
@@ -135,15 +135,15 @@ class ObstacleSpec(StrictModel):
     name: str | None = None
     mesh: str | None = None
     scale: Scale | Annotated[list[Scale], Field(min_length=3, max_length=3)] = 1.0
-    decompose: bool = False  # CoACD convex decomposition instead of the hull
+    decompose: bool = False
     max_vertices: Annotated[int, Field(ge=1, le=100_000_000)] = MAX_DECOMPOSE_VERTICES
     box: Sizes3 | None = None
     sphere: PositiveLength | None = None
-    cylinder: Sizes2 | None = None  # [radius, length]
-    capsule: Sizes2 | None = None  # [radius, length]
+    cylinder: Sizes2 | None = None
+    capsule: Sizes2 | None = None
     position: Point = Field(default_factory=lambda: [0.0, 0.0, 0.0])
     rpy: Rpy = Field(default_factory=lambda: [0.0, 0.0, 0.0])
-    velocity: Point | None = None  # [m/s]: the obstacle moves at constant velocity
+    velocity: Point | None = None
 
     @model_validator(mode="after")
     def _one_shape(self) -> ObstacleSpec:

@@ -21,9 +21,18 @@ _RELATIVE_TOLERANCE = 1e-12  # stop when |v|² − v·w <= tol·|v|² (Gilbert e
 
 @jit()
 def _support(
-    vertices: np.ndarray, neighbours: np.ndarray, offsets: np.ndarray, hint: int,
-    R: np.ndarray, p: np.ndarray, dx: float, dy: float, dz: float, out: np.ndarray, sign: float,
-) -> int:  # fmt: skip
+    vertices: np.ndarray,
+    neighbours: np.ndarray,
+    offsets: np.ndarray,
+    hint: int,
+    R: np.ndarray,
+    p: np.ndarray,
+    dx: float,
+    dy: float,
+    dz: float,
+    out: np.ndarray,
+    sign: float,
+) -> int:
     """out += sign · (the vertex of a posed core (R, p) furthest along world direction d);
     returns that vertex's index.
 
@@ -64,10 +73,20 @@ def _add_vertex(
 
 @jit()
 def gjk_distance(
-    vertices: np.ndarray, neighbours: np.ndarray, offsets: np.ndarray, hints: np.ndarray,
-    a: int, R_a: np.ndarray, p_a: np.ndarray, radius_a: float,
-    b: int, R_b: np.ndarray, p_b: np.ndarray, radius_b: float, simplex: np.ndarray,
-) -> float:  # fmt: skip
+    vertices: np.ndarray,
+    neighbours: np.ndarray,
+    offsets: np.ndarray,
+    hints: np.ndarray,
+    a: int,
+    R_a: np.ndarray,
+    p_a: np.ndarray,
+    radius_a: float,
+    b: int,
+    R_b: np.ndarray,
+    p_b: np.ndarray,
+    radius_b: float,
+    simplex: np.ndarray,
+) -> float:
     """Distance [m] between two posed cores a and b swept by their radii; 0 when they overlap.
 
     `vertices` holds every core; `neighbours[offsets[k]:offsets[k + 1]]` are the vertices
@@ -97,17 +116,29 @@ def gjk_distance(
     Returns:
         The distance between the two swept shapes, 0 when they overlap [m].
     """
-    return _gjk(vertices, neighbours, offsets, hints, a, R_a, p_a, radius_a, b, R_b, p_b,
-                radius_b, simplex)[0]  # fmt: skip
+    return _gjk(
+        vertices, neighbours, offsets, hints, a, R_a, p_a, radius_a, b, R_b, p_b, radius_b, simplex
+    )[0]
 
 
 @jit()
 def gjk_witnesses(
-    vertices: np.ndarray, neighbours: np.ndarray, offsets: np.ndarray, hints: np.ndarray,
-    a: int, R_a: np.ndarray, p_a: np.ndarray, radius_a: float,
-    b: int, R_b: np.ndarray, p_b: np.ndarray, radius_b: float, simplex: np.ndarray,
-    on_a: np.ndarray, on_b: np.ndarray,
-) -> float:  # fmt: skip
+    vertices: np.ndarray,
+    neighbours: np.ndarray,
+    offsets: np.ndarray,
+    hints: np.ndarray,
+    a: int,
+    R_a: np.ndarray,
+    p_a: np.ndarray,
+    radius_a: float,
+    b: int,
+    R_b: np.ndarray,
+    p_b: np.ndarray,
+    radius_b: float,
+    simplex: np.ndarray,
+    on_a: np.ndarray,
+    on_b: np.ndarray,
+) -> float:
     """gjk_distance, and the closest points of the two shapes' surfaces [m, world] written to
     on_a and on_b; when the shapes overlap (0 returned) on_a and on_b are left as they were.
 
@@ -135,8 +166,9 @@ def gjk_witnesses(
     Returns:
         The distance between the two swept shapes, 0 when they overlap [m].
     """
-    d, W, Wa, n = _gjk(vertices, neighbours, offsets, hints, a, R_a, p_a, radius_a, b, R_b,
-                       p_b, radius_b, simplex)  # fmt: skip
+    d, W, Wa, n = _gjk(
+        vertices, neighbours, offsets, hints, a, R_a, p_a, radius_a, b, R_b, p_b, radius_b, simplex
+    )
     if n == 0:
         return d
     weights = _barycentric(W, n)
@@ -186,10 +218,20 @@ def _barycentric(W: np.ndarray, n: int) -> np.ndarray:
 
 @jit()
 def _gjk(
-    vertices: np.ndarray, neighbours: np.ndarray, offsets: np.ndarray, hints: np.ndarray,
-    a: int, R_a: np.ndarray, p_a: np.ndarray, radius_a: float,
-    b: int, R_b: np.ndarray, p_b: np.ndarray, radius_b: float, simplex: np.ndarray,
-) -> tuple[float, np.ndarray, np.ndarray, int]:  # fmt: skip
+    vertices: np.ndarray,
+    neighbours: np.ndarray,
+    offsets: np.ndarray,
+    hints: np.ndarray,
+    a: int,
+    R_a: np.ndarray,
+    p_a: np.ndarray,
+    radius_a: float,
+    b: int,
+    R_b: np.ndarray,
+    p_b: np.ndarray,
+    radius_b: float,
+    simplex: np.ndarray,
+) -> tuple[float, np.ndarray, np.ndarray, int]:
     """GJK itself: (distance, the final simplex W of A − B, the A supports Wa of its vertices,
     its size n; 0 when the shapes overlap), from and back into the `simplex` cache."""
     # Three allocations, the rest views: this runs a few hundred times per control period.
@@ -200,19 +242,20 @@ def _gjk(
     keep, best_keep = flags[0:4], flags[4:8]
     ids = np.empty((4, 2), dtype=np.int64)  # (A vertex, B vertex) of each simplex point
     hint_a, hint_b = hints[a], hints[b]
-    n = _cached_simplex(vertices, R_a, p_a, R_b, p_b, simplex, W, Wa, ids, keep, best_keep,
-                        trial, v)  # fmt: skip
+    n = _cached_simplex(
+        vertices, R_a, p_a, R_b, p_b, simplex, W, Wa, ids, keep, best_keep, trial, v
+    )
     if n == 0:
         # No usable cache: start from a point of A − B along the centres' offset.
         dx, dy, dz = p_b[0] - p_a[0], p_b[1] - p_a[1], p_b[2] - p_a[2]
         if dx == 0.0 and dy == 0.0 and dz == 0.0:
             dx = 1.0
         Wa[0] = 0.0
-        hint_a = _support(vertices, neighbours, offsets, hint_a, R_a, p_a, dx, dy, dz, Wa[0],
-                          1.0)  # fmt: skip
+        hint_a = _support(vertices, neighbours, offsets, hint_a, R_a, p_a, dx, dy, dz, Wa[0], 1.0)
         W[0] = Wa[0]
-        hint_b = _support(vertices, neighbours, offsets, hint_b, R_b, p_b, -dx, -dy, -dz, W[0],
-                          -1.0)  # fmt: skip
+        hint_b = _support(
+            vertices, neighbours, offsets, hint_b, R_b, p_b, -dx, -dy, -dz, W[0], -1.0
+        )
         ids[0, 0], ids[0, 1] = hint_a, hint_b
         v[:] = W[0]
         n = 1
@@ -221,11 +264,11 @@ def _gjk(
         # w = s_A(−v) − s_B(v), the support of A − B towards the origin.
         dx, dy, dz = -v[0], -v[1], -v[2]
         support_a[:] = 0.0
-        hint_a = _support(vertices, neighbours, offsets, hint_a, R_a, p_a, dx, dy, dz,
-                          support_a, 1.0)  # fmt: skip
+        hint_a = _support(
+            vertices, neighbours, offsets, hint_a, R_a, p_a, dx, dy, dz, support_a, 1.0
+        )
         w[:] = support_a
-        hint_b = _support(vertices, neighbours, offsets, hint_b, R_b, p_b, -dx, -dy, -dz, w,
-                          -1.0)  # fmt: skip
+        hint_b = _support(vertices, neighbours, offsets, hint_b, R_b, p_b, -dx, -dy, -dz, w, -1.0)
         vv = _dot(v, v)
         vw = _dot(v, w)
         if vw > 0.0:
@@ -260,10 +303,20 @@ def _gjk(
 
 @jit()
 def _cached_simplex(
-    vertices: np.ndarray, R_a: np.ndarray, p_a: np.ndarray, R_b: np.ndarray, p_b: np.ndarray,
-    simplex: np.ndarray, W: np.ndarray, Wa: np.ndarray, ids: np.ndarray, keep: np.ndarray,
-    best_keep: np.ndarray, trial: np.ndarray, v: np.ndarray,
-) -> int:  # fmt: skip
+    vertices: np.ndarray,
+    R_a: np.ndarray,
+    p_a: np.ndarray,
+    R_b: np.ndarray,
+    p_b: np.ndarray,
+    simplex: np.ndarray,
+    W: np.ndarray,
+    Wa: np.ndarray,
+    ids: np.ndarray,
+    keep: np.ndarray,
+    best_keep: np.ndarray,
+    trial: np.ndarray,
+    v: np.ndarray,
+) -> int:
     """The cached simplex's vertices at the new poses in W, Wa, ids, reduced to the feature
     closest to the origin (v); returns its size, 0 when there is none or it holds the origin."""
     n = simplex[0]

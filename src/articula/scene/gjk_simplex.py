@@ -114,17 +114,24 @@ def _beyond_face(W: np.ndarray, ia: int, ib: int, ic: int, iopp: int) -> bool:
     acx, acy, acz = W[ic, 0] - W[ia, 0], W[ic, 1] - W[ia, 1], W[ic, 2] - W[ia, 2]
     nx, ny, nz = aby * acz - abz * acy, abz * acx - abx * acz, abx * acy - aby * acx
     side_origin = -(nx * W[ia, 0] + ny * W[ia, 1] + nz * W[ia, 2])
-    side_opposite = (nx * (W[iopp, 0] - W[ia, 0]) + ny * (W[iopp, 1] - W[ia, 1])
-                     + nz * (W[iopp, 2] - W[ia, 2]))  # fmt: skip
+    side_opposite = (
+        nx * (W[iopp, 0] - W[ia, 0]) + ny * (W[iopp, 1] - W[ia, 1]) + nz * (W[iopp, 2] - W[ia, 2])
+    )
     flat = abs(side_opposite) <= 1e-14 * max(nx * nx + ny * ny + nz * nz, 1e-300)
     return flat or side_origin * side_opposite < 0.0
 
 
 @jit()
 def _closest_on_simplex(
-    W: np.ndarray, Wa: np.ndarray, ids: np.ndarray, n: int, keep: np.ndarray,
-    best_keep: np.ndarray, trial: np.ndarray, out: np.ndarray,
-) -> int:  # fmt: skip
+    W: np.ndarray,
+    Wa: np.ndarray,
+    ids: np.ndarray,
+    n: int,
+    keep: np.ndarray,
+    best_keep: np.ndarray,
+    trial: np.ndarray,
+    out: np.ndarray,
+) -> int:
     """out = the closest point to the origin on the simplex W[:n] (Wa: the A supports of its
     vertices, ids: their vertex indices in A and B, reduced alike); returns the reduced
     simplex size, 4 meaning the origin is inside the tetrahedron (the shapes overlap)."""

@@ -71,8 +71,14 @@ def check_pose(what: str, T: np.ndarray) -> np.ndarray:
     # det R and the entries of R Rᵀ − I, in scalars: numpy's per-call overhead would dominate.
     (a, b, c), (d, e, f), (g, h, i) = T[:3, :3].tolist()
     det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
-    gram = (a * a + b * b + c * c - 1.0, d * d + e * e + f * f - 1.0, g * g + h * h + i * i - 1.0,
-            a * d + b * e + c * f, a * g + b * h + c * i, d * g + e * h + f * i)  # fmt: skip
+    gram = (
+        a * a + b * b + c * c - 1.0,
+        d * d + e * e + f * f - 1.0,
+        g * g + h * h + i * i - 1.0,
+        a * d + b * e + c * f,
+        a * g + b * h + c * i,
+        d * g + e * h + f * i,
+    )
     if max(map(abs, gram)) > 1e-5 or det < 0:
         raise GeometryError(f"{what}: pose rotation is not a rotation matrix")
     return T

@@ -22,8 +22,8 @@ class Witnesses:
     """
 
     distance: np.ndarray
-    on_link: np.ndarray  # (links, obstacles, 3)
-    on_obstacle: np.ndarray  # (links, obstacles, 3)
+    on_link: np.ndarray
+    on_obstacle: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -37,9 +37,9 @@ class SelfWitnesses:
         on_b: closest point on link b of each pair, world, shape (pairs, 3) [m].
     """
 
-    distance: np.ndarray  # (pairs,)
-    on_a: np.ndarray  # (pairs, 3)
-    on_b: np.ndarray  # (pairs, 3)
+    distance: np.ndarray
+    on_a: np.ndarray
+    on_b: np.ndarray
 
 
 def link_pairs(
@@ -63,8 +63,9 @@ def link_pairs(
         a, b = pair
         for name in (a, b):
             if name not in links:
-                raise ConfigError(field, f"no link {name!r} with collision shapes; "
-                                  f"the links are {links}")  # fmt: skip
+                raise ConfigError(
+                    field, f"no link {name!r} with collision shapes; the links are {links}"
+                )
         if a == b:
             raise ConfigError(field, f"a link cannot collide with itself ({a!r})")
         out.add(tuple(sorted((links.index(a), links.index(b)))))

@@ -100,8 +100,13 @@ class Scene(_PairDistances):
         for li, link in enumerate(robot.links):
             frame = robot.model.frames[link.frame_id]
             for si, (shape, T) in enumerate(zip(link.shapes, link.placements, strict=True)):
-                g = geo.add(f"{link.name}/{si}", frame.parentJoint, link.frame_id,
-                            frame.placement * pin.SE3(T), shape)  # fmt: skip
+                g = geo.add(
+                    f"{link.name}/{si}",
+                    frame.parentJoint,
+                    link.frame_id,
+                    frame.placement * pin.SE3(T),
+                    shape,
+                )
                 link_geoms.append((g, li))
         self._obstacle_geoms = []
         for obstacle in self.obstacles:
@@ -348,8 +353,9 @@ class Scene(_PairDistances):
     def _place(self, q: np.ndarray, t: float) -> None:
         """Forward kinematics and every exact shape placement, obstacles at time t."""
         self._move_obstacles(t)
-        pin.updateGeometryPlacements(self.robot.model, self.robot.data, self._geo.exact,
-                                     self._exact_data, q)  # fmt: skip
+        pin.updateGeometryPlacements(
+            self.robot.model, self.robot.data, self._geo.exact, self._exact_data, q
+        )
 
     def _cell_minima(self, pair_distances: list[float]) -> np.ndarray:
         out = np.full(self._shape, np.inf)

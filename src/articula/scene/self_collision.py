@@ -190,8 +190,12 @@ def _cache_key(
     digest = hashlib.sha256(_FORMAT.encode())
     for placement, joint in zip(model.jointPlacements, model.joints, strict=True):
         digest.update(joint.shortname().encode() + placement.homogeneous.tobytes())
-    for values in (model.lowerPositionLimit, model.upperPositionLimit, robot.continuous,
-                   np.asarray(model.parents)):  # fmt: skip
+    for values in (
+        model.lowerPositionLimit,
+        model.upperPositionLimit,
+        robot.continuous,
+        np.asarray(model.parents),
+    ):
         digest.update(np.ascontiguousarray(values).tobytes())
     for link in robot.links:
         frame = model.frames[link.frame_id]

@@ -94,10 +94,10 @@ class StepFeatures:
         peak_sizes: |output − final level| at those extremes, shape (s,).
     """
 
-    overshoot: float  # largest excursion past the target (response units, >= 0)
-    steady_state_error: float  # |target − mean output| over the last quarter of the run
-    peak_times: np.ndarray  # [s] extremes of each swing about the final level, beyond the band
-    peak_sizes: np.ndarray  # |output − final level| at those extremes
+    overshoot: float
+    steady_state_error: float
+    peak_times: np.ndarray
+    peak_sizes: np.ndarray
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "peak_times", readonly(self.peak_times))

@@ -81,11 +81,16 @@ def add_robot(
         meshes[link] = []
         for i, visual in enumerate(items):
             wxyz, position = wxyz_position(visual.placement)
-            meshes[link].append(server.scene.add_mesh_simple(
-                f"/robot/{link}/visual_{i}", np.asarray(visual.mesh.vertices, dtype=np.float32),
-                np.asarray(visual.mesh.faces, dtype=np.uint32), color=ROBOT_COLOUR,
-                wxyz=wxyz, position=position,
-            ))  # fmt: skip
+            meshes[link].append(
+                server.scene.add_mesh_simple(
+                    f"/robot/{link}/visual_{i}",
+                    np.asarray(visual.mesh.vertices, dtype=np.float32),
+                    np.asarray(visual.mesh.faces, dtype=np.uint32),
+                    color=ROBOT_COLOUR,
+                    wxyz=wxyz,
+                    position=position,
+                )
+            )
     return frames, meshes
 
 
@@ -125,9 +130,12 @@ def add_obstacle_parts(server: viser.ViserServer, scene: Scene) -> None:
         for i, part in enumerate(obstacle.parts):
             hull = trimesh.convex.convex_hull(part.vertices)
             server.scene.add_mesh_simple(
-                f"/obstacles/{obstacle.name}/part_{i}", np.asarray(hull.vertices, np.float32),
-                np.asarray(hull.faces, np.uint32), color=OBSTACLE_COLOUR, opacity=0.8,
-            )  # fmt: skip
+                f"/obstacles/{obstacle.name}/part_{i}",
+                np.asarray(hull.vertices, np.float32),
+                np.asarray(hull.faces, np.uint32),
+                color=OBSTACLE_COLOUR,
+                opacity=0.8,
+            )
 
 
 def pose_of(wxyz: np.ndarray, position: np.ndarray) -> np.ndarray:
@@ -159,5 +167,4 @@ def add_path(server: viser.ViserServer, name: str, points: np.ndarray, colour: t
     if len(points) < 2:
         return
     segments = np.stack([points[:-1], points[1:]], axis=1).astype(np.float32)
-    server.scene.add_line_segments(name, segments, colour, thickness=3.0,
-                                   thickness_units="screen")  # fmt: skip
+    server.scene.add_line_segments(name, segments, colour, thickness=3.0, thickness_units="screen")

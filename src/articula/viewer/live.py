@@ -137,10 +137,12 @@ class Live:
         for obstacle in self.scene.obstacles:
             wxyz, position = drawing.wxyz_position(obstacle.pose_at(0.0))
             self.gizmos[obstacle.name] = server.scene.add_transform_controls(
-                f"/obstacles/{obstacle.name}", scale=0.2, wxyz=wxyz, position=position)  # fmt: skip
+                f"/obstacles/{obstacle.name}", scale=0.2, wxyz=wxyz, position=position
+            )
         drawing.add_obstacle_parts(server, self.scene)
-        self.target = server.scene.add_transform_controls("/target", scale=0.15,
-                                                          disable_rotations=True)  # fmt: skip
+        self.target = server.scene.add_transform_controls(
+            "/target", scale=0.15, disable_rotations=True
+        )
         server.scene.add_icosphere("/target/ball", radius=0.01, color=drawing.REFERENCE_COLOUR)
         self.recording = Recording()
         self.colours: dict[str, tuple[int, int, int]] = {}  # as painted (painter's thread)
@@ -162,8 +164,11 @@ class Live:
         Returns:
             The planner's settings.
         """
-        panel = {"method": self.method.value, "lambda_weight": float(self.lam.value),
-                 "d_min": float(self.d_min.value)}  # fmt: skip
+        panel = {
+            "method": self.method.value,
+            "lambda_weight": float(self.lam.value),
+            "d_min": float(self.d_min.value),
+        }
         return PlannerSpec(**(self.config["planner"] | panel))
 
     def rebuild(self) -> None:
@@ -186,8 +191,11 @@ class Live:
             self.readout.content = f"**not changed:** {exc}"
             return
         self.controller = controller
-        self.config["planner"] |= {"method": spec.method, "lambda_weight": spec.lambda_weight,
-                                   "d_min": spec.d_min}  # fmt: skip
+        self.config["planner"] |= {
+            "method": spec.method,
+            "lambda_weight": spec.lambda_weight,
+            "d_min": spec.d_min,
+        }
 
     def period(self) -> float:
         """One control period: obstacles from their gizmos, one planner step, the page
@@ -221,8 +229,11 @@ class Live:
         x = scene.robot.ee_position(self.q)
         late = elapsed > self.dt
         if late or self.periods % DRAW_EVERY == 0:
-            d = (scene.distances(self.q, t) if scene.obstacles
-                 else np.full((len(scene.robot.links), 1), np.inf))  # fmt: skip
+            d = (
+                scene.distances(self.q, t)
+                if scene.obstacles
+                else np.full((len(scene.robot.links), 1), np.inf)
+            )
             clearance = float(d.min())
             self._draw(d, x, target, clearance, elapsed)
         else:
@@ -248,14 +259,18 @@ class Live:
         poses = scene.robot.link_poses(self.q)
         frames = {name: drawing.wxyz_position(poses[name]) for name in self.frames if name in poses}
         d_min = float(self.d_min.value)
-        colours = {link.name: drawing.clearance_colour(float(d[i].min()), d_min)
-                   for i, link in enumerate(scene.robot.links)}  # fmt: skip
+        colours = {
+            link.name: drawing.clearance_colour(float(d[i].min()), d_min)
+            for i, link in enumerate(scene.robot.links)
+        }
         readout = None
         if late or self.periods % READOUT_EVERY == 0:
             error = float(np.linalg.norm(x - target))
-            readout = (f"clearance **{1e3 * clearance:.1f} mm** · error {1e3 * error:.2f} mm"
-                       f" · planner {1e3 * elapsed:.2f} ms per {1e3 * self.dt:.0f} ms period"
-                       + (" · **over the period**" if late else ""))  # fmt: skip
+            readout = (
+                f"clearance **{1e3 * clearance:.1f} mm** · error {1e3 * error:.2f} mm"
+                f" · planner {1e3 * elapsed:.2f} ms per {1e3 * self.dt:.0f} ms period"
+                + (" · **over the period**" if late else "")
+            )
         shown = target.copy() if self.follow.value else None
         self.painter.post(lambda: self._paint(frames, colours, readout, shown))
 
@@ -307,9 +322,17 @@ class Live:
         if not r.t:
             raise ArticulaError("--record: nothing happened yet (no control period ran)")
         x, x_ref = np.array(r.x), np.array(r.x_ref)
-        run = PlanResult(np.array(r.t), np.array(r.q), x, x_ref, np.linalg.norm(x - x_ref, axis=1),
-                         np.array(r.clearance), 1e-3 * float(np.sum(self.step_ms[1:])),
-                         1e-3 * self.step_ms[0], self.q0)  # fmt: skip
+        run = PlanResult(
+            np.array(r.t),
+            np.array(r.q),
+            x,
+            x_ref,
+            np.linalg.norm(x - x_ref, axis=1),
+            np.array(r.clearance),
+            1e-3 * float(np.sum(self.step_ms[1:])),
+            1e-3 * self.step_ms[0],
+            self.q0,
+        )
         iterations = float(self.controller.planner.iterations) if self.controller else 0.0
         metrics = tracking_metrics(run, self.scene.robot, 0.0, iterations)
         metrics["overrun_fraction"] = float(np.mean(np.array(self.step_ms) > 1e3 * self.dt))
@@ -332,8 +355,9 @@ def _plan_config(scene_file: Path) -> dict[str, Any]:
     return absolute_paths(data, scene_file.resolve().parent)
 
 
-def run_live(scene_file: Path, method: str | None, host: str, port: int, record: Path | None,
-             announce) -> None:  # fmt: skip
+def run_live(
+    scene_file: Path, method: str | None, host: str, port: int, record: Path | None, announce
+) -> None:
     """Serve the live page until Ctrl-C, a period every dt; then write --record if asked.
 
     Args:

@@ -39,8 +39,9 @@ class Replay:
         self.server = server
         self.runs = {path.name: path for path in runs}
         gui = server.gui
-        self.picker = gui.add_dropdown("run", tuple(self.runs), initial_value=runs[0].name,
-                                       visible=len(runs) > 1)  # fmt: skip
+        self.picker = gui.add_dropdown(
+            "run", tuple(self.runs), initial_value=runs[0].name, visible=len(runs) > 1
+        )
         self.slider = gui.add_slider("time [s]", 0.0, 1.0, 0.01, 0.0)
         self.playing = gui.add_checkbox("play", False)
         self.speed = gui.add_dropdown("speed", SPEEDS, initial_value="1")
@@ -76,9 +77,12 @@ class Replay:
             plot.remove()
         self.plots = [
             self._plot("error [mm]", run.t, 1e3 * run.error),
-            self._plot("clearance [mm]", run.t, 1e3 * np.where(np.isfinite(run.clearance),
-                                                                run.clearance, np.nan)),
-        ]  # fmt: skip
+            self._plot(
+                "clearance [mm]",
+                run.t,
+                1e3 * np.where(np.isfinite(run.clearance), run.clearance, np.nan),
+            ),
+        ]
         self.show(0)
 
     def show(self, k: int) -> None:
@@ -104,13 +108,16 @@ class Replay:
         if closest is not None:
             points = np.array([[closest.on_link, closest.on_obstacle]], dtype=np.float32)
             self.closest_line = self.server.scene.add_line_segments(
-                "/closest", points, drawing.CLOSEST_COLOUR, thickness=4.0,
-                thickness_units="screen")  # fmt: skip
+                "/closest", points, drawing.CLOSEST_COLOUR, thickness=4.0, thickness_units="screen"
+            )
             self.closest_label = self.server.scene.add_label(
-                "/closest/label", f"{1e3 * closest.distance:.1f} mm",
-                position=(closest.on_link + closest.on_obstacle) / 2)  # fmt: skip
-            text += (f" · closest: {closest.link} – {closest.obstacle}, "
-                     f"{1e3 * closest.distance:.1f} mm")  # fmt: skip
+                "/closest/label",
+                f"{1e3 * closest.distance:.1f} mm",
+                position=(closest.on_link + closest.on_obstacle) / 2,
+            )
+            text += (
+                f" · closest: {closest.link} – {closest.obstacle}, {1e3 * closest.distance:.1f} mm"
+            )
         self.status.content = text
 
     def tick(self, elapsed: float) -> None:
@@ -138,8 +145,10 @@ class Replay:
         return self.server.gui.add_uplot(
             data=(t, values),
             series=(uplot.Series(label="t [s]"), uplot.Series(label=label, stroke="#d9480f")),
-            scales={"x": uplot.Scale(time=False)}, title=label, aspect=2.0,
-        )  # fmt: skip
+            scales={"x": uplot.Scale(time=False)},
+            title=label,
+            aspect=2.0,
+        )
 
 
 def open_server(host: str, port: int) -> viser.ViserServer:
@@ -157,8 +166,9 @@ def open_server(host: str, port: int) -> viser.ViserServer:
         try:
             probe.bind((host, port))
         except OSError as exc:
-            raise ConfigError("--port", f"cannot listen on {host}:{port} ({exc.strerror}); "
-                              "choose another port") from None  # fmt: skip
+            raise ConfigError(
+                "--port", f"cannot listen on {host}:{port} ({exc.strerror}); choose another port"
+            ) from None
     with captured_output():  # viser's banner: the command prints its own one line
         return viser.ViserServer(host=host, port=port, verbose=False)
 

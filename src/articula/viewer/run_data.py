@@ -75,7 +75,7 @@ class RunData:
     clearance: np.ndarray
     visuals: dict[str, list[Visual]]
     d_min: float
-    obstacle_track: dict[str, np.ndarray]  # name -> (samples, 7) x, y, z, qw, qx, qy, qz (live)
+    obstacle_track: dict[str, np.ndarray]
 
     def link_poses(self, k: int) -> dict[str, np.ndarray]:
         """Pose (4×4, world) of every link with something to draw, at sample k.
@@ -99,8 +99,12 @@ class RunData:
         Returns:
             Obstacle name -> its pose, shape (4, 4) [m].
         """
-        return {o.name: self._track(o.name, k) if o.name in self.obstacle_track
-                else o.pose_at(float(self.t[k])) for o in self.scene.obstacles}  # fmt: skip
+        return {
+            o.name: self._track(o.name, k)
+            if o.name in self.obstacle_track
+            else o.pose_at(float(self.t[k]))
+            for o in self.scene.obstacles
+        }
 
     def _track(self, name: str, k: int) -> np.ndarray:
         """The recorded pose of obstacle `name` at sample k."""
@@ -138,9 +142,13 @@ class RunData:
             return None
         w = self._scene_at(k).witnesses(self.q[k], float(self.t[k]))
         li, oi = np.unravel_index(int(np.argmin(w.distance)), w.distance.shape)
-        return Closest(self.scene.robot.links[li].name, self.scene.obstacles[oi].name,
-                       w.on_link[li, oi].copy(), w.on_obstacle[li, oi].copy(),
-                       float(w.distance[li, oi]))  # fmt: skip
+        return Closest(
+            self.scene.robot.links[li].name,
+            self.scene.obstacles[oi].name,
+            w.on_link[li, oi].copy(),
+            w.on_obstacle[li, oi].copy(),
+            float(w.distance[li, oi]),
+        )
 
     def _scene_at(self, k: int) -> Scene:
         """The scene with its obstacles where they were at sample k."""
@@ -148,8 +156,14 @@ class RunData:
             return self.scene
         poses = self.obstacle_poses(k)
         obstacles = [Obstacle(o.name, o.parts, poses[o.name]) for o in self.scene.obstacles]
-        return Scene(self.scene.robot, obstacles, self.scene.broadphase, self.scene.metric,
-                     self.scene.self_pair_names, self.scene.self_d_min)  # fmt: skip
+        return Scene(
+            self.scene.robot,
+            obstacles,
+            self.scene.broadphase,
+            self.scene.metric,
+            self.scene.self_pair_names,
+            self.scene.self_d_min,
+        )
 
 
 class RunFolderError(ConfigError):
@@ -173,9 +187,10 @@ def run_folders(folder: Path) -> list[Path]:
     runs = sorted(p for p in folder.iterdir() if p.is_dir() and _is_plan(p))
     if not runs:
         raise RunFolderError(
-            "RUN_DIR", f"{folder} holds no planner run (a folder with config.toml and "
-            "trace.parquet written by `articula plan`, or a sweep of them)"
-        )  # fmt: skip
+            "RUN_DIR",
+            f"{folder} holds no planner run (a folder with config.toml and "
+            "trace.parquet written by `articula plan`, or a sweep of them)",
+        )
     return runs
 
 
@@ -205,9 +220,10 @@ def load_run(folder: Path) -> RunData:
         raise RunFolderError("RUN_DIR", f"cannot read {folder / CONFIG} ({exc})") from None
     if config.get("experiment") != PLAN:
         raise RunFolderError(
-            "RUN_DIR", f"{folder} is a run of {config.get('experiment')!r}; view shows {PLAN} "
-            "runs (articula plan)"
-        )  # fmt: skip
+            "RUN_DIR",
+            f"{folder} is a run of {config.get('experiment')!r}; view shows {PLAN} "
+            "runs (articula plan)",
+        )
     try:
         trace = pq.read_table(folder / TRACE).to_pydict()
     except (OSError, ValueError) as exc:
@@ -216,14 +232,22 @@ def load_run(folder: Path) -> RunData:
     nq = scene.robot.nq
     column = lambda *names: np.column_stack([trace[n] for n in names])  # noqa: E731
     return RunData(
-        folder=folder, scene=scene, t=np.asarray(trace["t"]),
-        q=column(*(f"q_{i + 1}" for i in range(nq))), x=column("x", "y", "z"),
-        x_ref=column("x_ref", "y_ref", "z_ref"), error=np.asarray(trace["error"]),
-        clearance=np.asarray(trace["clearance"]), visuals=visuals_of(config["robot"], scene),
+        folder=folder,
+        scene=scene,
+        t=np.asarray(trace["t"]),
+        q=column(*(f"q_{i + 1}" for i in range(nq))),
+        x=column("x", "y", "z"),
+        x_ref=column("x_ref", "y_ref", "z_ref"),
+        error=np.asarray(trace["error"]),
+        clearance=np.asarray(trace["clearance"]),
+        visuals=visuals_of(config["robot"], scene),
         d_min=float(config.get("planner", {}).get("d_min", 0.0)),
-        obstacle_track={o.name: column(*(f"obstacle_{o.name}_{c}" for c in TRACK))
-                        for o in scene.obstacles if f"obstacle_{o.name}_x" in trace},
-    )  # fmt: skip
+        obstacle_track={
+            o.name: column(*(f"obstacle_{o.name}_{c}" for c in TRACK))
+            for o in scene.obstacles
+            if f"obstacle_{o.name}_x" in trace
+        },
+    )
 
 
 def visuals_of(robot: dict, scene: Scene) -> dict[str, list[Visual]]:
@@ -250,6 +274,10 @@ def visuals_of(robot: dict, scene: Scene) -> dict[str, list[Visual]]:
     drawn = {name: v for name, v in visuals.items() if model.existFrame(name) and v}
     if drawn:
         return drawn
-    return {link.name: [Visual(trimesh.convex.convex_hull(shape.vertices), T, None)
-                        for shape, T in zip(link.shapes, link.placements, strict=True)]
-            for link in scene.robot.links}  # fmt: skip
+    return {
+        link.name: [
+            Visual(trimesh.convex.convex_hull(shape.vertices), T, None)
+            for shape, T in zip(link.shapes, link.placements, strict=True)
+        ]
+        for link in scene.robot.links
+    }

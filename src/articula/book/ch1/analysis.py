@@ -20,9 +20,17 @@ from articula.book.claims import Claim, decide
 
 Metrics = Mapping[str, Mapping[str, float]]
 Table = Mapping[str, Mapping[str, Mapping[str, Any]]]
-AVERAGED = ("rms_error", "max_error", "min_clearance", "min_clearance_settled", "collisions",
-            "collisions_settled", "joint_limit_violations", "time_per_iteration_us",
-            "time_per_period_us")  # fmt: skip
+AVERAGED = (
+    "rms_error",
+    "max_error",
+    "min_clearance",
+    "min_clearance_settled",
+    "collisions",
+    "collisions_settled",
+    "joint_limit_violations",
+    "time_per_iteration_us",
+    "time_per_period_us",
+)
 TRACKING_TARGET = 1e-3  # [m] RMS after settling of the Λ = 0 runs (the issue's target)
 
 
@@ -41,16 +49,19 @@ def comparison(metrics: Metrics) -> dict[str, dict[str, dict[str, Any]]]:
             rows = [metrics[n] for n in names]
             entry: dict[str, Any] = {k: statistics.fmean(r[k] for r in rows) for k in AVERAGED}
             entry["runs"] = len(rows)
-            entry["rms_error_range"] = [min(r["rms_error"] for r in rows),
-                                        max(r["rms_error"] for r in rows)]  # fmt: skip
+            entry["rms_error_range"] = [
+                min(r["rms_error"] for r in rows),
+                max(r["rms_error"] for r in rows),
+            ]
             table[scene][method] = entry
     return table
 
 
 def colliding_methods(table: Table) -> list[tuple[str, str]]:
     """(scene, method) of every comparison row with a colliding step."""
-    return [(s, m) for s, methods in table.items() for m, r in methods.items()
-            if r["collisions"] > 0]  # fmt: skip
+    return [
+        (s, m) for s, methods in table.items() for m, r in methods.items() if r["collisions"] > 0
+    ]
 
 
 def _mm(value: float) -> str:

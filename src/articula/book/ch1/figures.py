@@ -106,8 +106,14 @@ def snapshots(
         n = int(np.argmin(np.abs(t - time)))
         arm = joint_points(scene, q[n])
         shown.append(arm)
-        ax.plot(*arm.T, "o-", color=plt.cm.plasma(k / max(len(times) - 1, 1)), lw=2, ms=3,
-                label=f"t = {t[n]:.1f} s")  # fmt: skip
+        ax.plot(
+            *arm.T,
+            "o-",
+            color=plt.cm.plasma(k / max(len(times) - 1, 1)),
+            lw=2,
+            ms=3,
+            label=f"t = {t[n]:.1f} s",
+        )
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_zlabel("z [m]")

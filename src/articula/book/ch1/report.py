@@ -102,8 +102,11 @@ def _comparison_lines(table: Table, full: bool, p: Mapping[str, Any]) -> list[st
     colliding = colliding_methods(table)
     if colliding:
         late = [f"{m} on {s}" for s, m in colliding if table[s][m]["collisions_settled"] > 0]
-        where = (f"after settling too: {', '.join(late)}" if late else
-                 "only while the arm swings in from q = 0 (none after settling), where the "
-                 "task itself drives a link at the obstacle")  # fmt: skip
+        where = (
+            f"after settling too: {', '.join(late)}"
+            if late
+            else "only while the arm swings in from q = 0 (none after settling), where the "
+            "task itself drives a link at the obstacle"
+        )
         lines += ["", f"Collisions ({', '.join(f'{m} on {s}' for s, m in colliding)}): {where}."]
     return [*lines, ""]

@@ -88,8 +88,13 @@ def plan_config(run: Run) -> dict[str, Any]:
         data["seed"] = overrides.pop("seed")
     # The book's Algorithm 1 has no joint limits on speed or acceleration and starts the path at
     # once: its runs keep none (limits = "none") and have no approach.
-    data["planner"] = {**data["planner"], **overrides, "tolerance": 1e3, "limits": "none",
-                       "approach": "none"}  # fmt: skip
+    data["planner"] = {
+        **data["planner"],
+        **overrides,
+        "tolerance": 1e3,
+        "limits": "none",
+        "approach": "none",
+    }
     return data
 
 

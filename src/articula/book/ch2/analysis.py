@@ -238,8 +238,9 @@ def spans(table: Table, book: Mapping[str, Sequence[Row]], still: float) -> list
         theirs = [rows[i][0] for rows in book.values()]
         ours = [table[n][f][0] for n in CONTROLLERS]
         above = sum(b > still for b in theirs)
-        result.append(Span(f, (min(ours), max(ours)), (min(theirs), max(theirs)), above,
-                           len(theirs)))  # fmt: skip
+        result.append(
+            Span(f, (min(ours), max(ours)), (min(theirs), max(theirs)), above, len(theirs))
+        )
     return result
 
 

@@ -40,9 +40,9 @@ class AngleReference(StrictModel):
     """
 
     kind: Literal["sinusoid", "steps"] = "sinusoid"
-    offset_deg: Angle = 45.0  # sinusoid: θ_r = offset − amplitude·cos(2πft), starts at rest
+    offset_deg: Angle = 45.0
     amplitude_deg: Angle = 45.0
-    frequency: NonNegative = 0.05  # [Hz]
+    frequency: NonNegative = 0.05
     levels_deg: Annotated[list[Angle], Field(min_length=1)] = Field(  # steps, in order
         default_factory=lambda: [90.0]
     )
@@ -76,7 +76,7 @@ class ControllerConfig(StrictModel):
             0: unfiltered, as in the book.
     """
 
-    name: str = "ordinary"  # a label, e.g. "fuzzy-auto"; reported, not interpreted
+    name: str = "ordinary"
     schedule: Literal["constant", "piecewise", "fuzzy"] = "constant"
     gains: Annotated[list[GainRow], Field(min_length=1)] = Field(  # rows [K_p, K_i, K_d]
         default_factory=lambda: [[1.0, 1.0, 0.0]]
@@ -84,8 +84,8 @@ class ControllerConfig(StrictModel):
     points_deg: list[Angle] = Field(  # representative points (Sect. 2.4.2.1)
         default_factory=lambda: [15.0, 45.0, 75.0]
     )
-    pwm_bits: Annotated[int, Field(ge=1, le=16)] = 8  # analogWrite: 0-255
-    derivative_tau: NonNegative = 0.0  # [s]; 0: unfiltered, as in the book
+    pwm_bits: Annotated[int, Field(ge=1, le=16)] = 8
+    derivative_tau: NonNegative = 0.0
 
     @model_validator(mode="after")
     def _rows_match(self) -> ControllerConfig:
@@ -131,10 +131,10 @@ class PneuNetPidConfig(StrictModel):
         plant: the simulated PneuNet's constants.
     """
 
-    seed: Seed = 0  # trial i draws its noise from seed + i
+    seed: Seed = 0
     trials: Annotated[int, Field(ge=1, le=MAX_TRIALS)] = 25
-    duration: Positive = 40.0  # [s]
-    settle: NonNegative = 0.0  # [s] before E is taken (0: every sample, as Eq. 2.7)
+    duration: Positive = 40.0
+    settle: NonNegative = 0.0
     reference: AngleReference = AngleReference()
     controller: ControllerConfig = ControllerConfig()
     plant: PneuNetParams = PneuNetParams()

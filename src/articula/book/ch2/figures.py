@@ -27,8 +27,13 @@ def manual_steps(result: ManualResult, title: str, path: Path) -> None:
     ax.plot(ref.t, ref.reference, color="C0", lw=1.5, label="reference")
     if chosen is not None:
         k = chosen.gains
-        ax.plot(chosen.response.t, chosen.response.measured, color="C3", lw=1.3,
-                label=f"chosen: K_p={k[0]:.3g}, K_i={k[1]:.3g}, K_d={k[2]:.3g}")  # fmt: skip
+        ax.plot(
+            chosen.response.t,
+            chosen.response.measured,
+            color="C3",
+            lw=1.3,
+            label=f"chosen: K_p={k[0]:.3g}, K_i={k[1]:.3g}, K_d={k[2]:.3g}",
+        )
     ax.plot([], [], color="0.7", lw=0.7, label="other trials of the procedure")
     ax.set_xlabel("time [s]")
     ax.set_ylabel("bending angle (sensor) [°]")
@@ -99,9 +104,14 @@ def error_summary(
             odd = (q[:, 1] > q[:, 0]) | (q[:, 2] < q[:, 0])
             for x, row in zip(shift[odd], q[odd], strict=True):
                 ax.plot(x, row[2], "o", ms=9, mfc="none", color="k", lw=0.8)
-                ax.annotate(f"{name}: Q1 {row[1]:g}, Q3 {row[2]:g}, median {row[0]:g} (misprint?)",
-                            (x, row[2]), xytext=(-150, -25), textcoords="offset points",
-                            fontsize=7, arrowprops={"arrowstyle": "-", "lw": 0.5})  # fmt: skip
+                ax.annotate(
+                    f"{name}: Q1 {row[1]:g}, Q3 {row[2]:g}, median {row[0]:g} (misprint?)",
+                    (x, row[2]),
+                    xytext=(-150, -25),
+                    textcoords="offset points",
+                    fontsize=7,
+                    arrowprops={"arrowstyle": "-", "lw": 0.5},
+                )
         ax.set_xscale("log")
         ax.set_xlabel("reference frequency [Hz]")
         ax.set_title(f"E, Eq. (2.7): median (Q1, Q3), {label}")

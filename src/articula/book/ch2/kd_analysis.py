@@ -77,9 +77,11 @@ def kd_verdict(probe: KdProbe) -> KdVerdict:
 def kd_summary(probe: KdProbe) -> KdSummary:
     """The probe's numbers per K_d as the report shows them, with its verdict."""
     return KdSummary(
-        probe.cost.mean(axis=1), np.median(probe.swings, axis=1), probe.sustained.sum(axis=1),
+        probe.cost.mean(axis=1),
+        np.median(probe.swings, axis=1),
+        probe.sustained.sum(axis=1),
         kd_verdict(probe),
-    )  # fmt: skip
+    )
 
 
 def kd_zero_status(verdicts: Mapping[str, KdVerdict]) -> Verdict:
@@ -104,9 +106,12 @@ def descent_kd(run: TuningRun) -> DescentKd:
     start = history[0]
     moved = any(h.k[2] != start.k[2] for h in history)
     return DescentKd(
-        float(start.k[2]), float(run.result.k[2]), moved, float(start.dk[2]),
+        float(start.k[2]),
+        float(run.result.k[2]),
+        moved,
+        float(start.dk[2]),
         float(history[-1].dk[2]),
-    )  # fmt: skip
+    )
 
 
 def tried_kd(result: ManualResult) -> tuple[float, ...]:

@@ -133,8 +133,10 @@ def _comparison_lines(comparison: Comparison, findings: Findings) -> list[str]:
         for n in CONTROLLERS:
             med, q1, q3 = c.table[n][f]
             mark = "**" if med == findings.lowest[f] else ""
-            cells.append(f"{mark}{fixed(med, 2)}{mark} ({fixed(q1, 2)}, {fixed(q3, 2)}) / "
-                         f"{fixed(BOOK_TABLE_2_3[n][i][0], 2)}")  # fmt: skip
+            cells.append(
+                f"{mark}{fixed(med, 2)}{mark} ({fixed(q1, 2)}, {fixed(q3, 2)}) / "
+                f"{fixed(BOOK_TABLE_2_3[n][i][0], 2)}"
+            )
         lines.append(f"| {f:g} | " + " | ".join(cells) + " |")
     fits = ", ".join(
         f"{f:g} Hz: {ratio:.2f}, {math.degrees(lag):.0f}°"
@@ -203,13 +205,16 @@ def _kd_lines(tuning: Tuning, findings: Findings) -> list[str]:
             for m, w, c in zip(s.mean_cost, s.median_swings, s.sustained, strict=True)
         ]
         v = s.verdict
-        rows.append(f"| {name} | " + " | ".join(cells) + f" | {v.lowest:g} | "
-                    f"{_kd_list(v.better)} | {_kd_list(v.worse)} |")  # fmt: skip
+        rows.append(
+            f"| {name} | " + " | ".join(cells) + f" | {v.lowest:g} | "
+            f"{_kd_list(v.better)} | {_kd_list(v.worse)} |"
+        )
     descent = "; ".join(
-        f"{key}: {d.start:.3g} → {d.final:.3g}" + ("" if d.moved else " (never moved)")
+        f"{key}: {d.start:.3g} → {d.final:.3g}"
+        + ("" if d.moved else " (never moved)")
         + f", step dK_d {d.step_start:.3g} → {d.step_final:.3g}"
         for key, d in findings.descent.items()
-    )  # fmt: skip
+    )
     ended = sum(d.final > 0 for d in findings.descent.values())
     stuck = sum(not d.moved for d in findings.descent.values())
     manual = "; ".join(

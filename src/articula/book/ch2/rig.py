@@ -45,8 +45,9 @@ def channels(info: Info) -> tuple[str, ...]:
 def reference_program(reference: AngleReference, duration: float) -> Program:
     """The reference as the rig's program: a sinusoid, or steps sharing the run equally."""
     if reference.kind == "sinusoid":
-        return Program(Shape.SINUSOID, (reference.offset_deg, reference.amplitude_deg,
-                                        reference.frequency))  # fmt: skip
+        return Program(
+            Shape.SINUSOID, (reference.offset_deg, reference.amplitude_deg, reference.frequency)
+        )
     return steps(reference.levels_deg, duration / len(reference.levels_deg))
 
 
@@ -54,23 +55,34 @@ def run_on_rig(config: PneuNetPidConfig, link: Link, recorder: Recorder) -> dict
     """Every trial of `config` on the rig behind `link`; returns the metrics."""
     c = config.controller
     if c.derivative_tau != 0.0 or c.pwm_bits != 8:
-        raise ConfigError("controller", "the rig's firmware runs the book's PID: unfiltered "
-                          "derivative (derivative_tau = 0), 8-bit PWM (pwm_bits = 8)")  # fmt: skip
+        raise ConfigError(
+            "controller",
+            "the rig's firmware runs the book's PID: unfiltered "
+            "derivative (derivative_tau = 0), 8-bit PWM (pwm_bits = 8)",
+        )
     points = np.array(c.points_deg) if c.schedule != "constant" else np.zeros(1)
     schedule = GainSchedule(c.schedule, np.array(c.gains), points)
     link.command(Kind.SET_GAINS, encode_gains(schedule))
     link.command(Kind.SET_REFERENCE, reference_program(config.reference, config.duration).encode())
     errors, costs = [], []
     for trial in range(config.trials):
-        t, values = run_program(link, config.duration, config.seed + trial,
-                                lambda t, row, k=trial: recorder.add(t, np.r_[k, row]))  # fmt: skip
+        t, values = run_program(
+            link,
+            config.duration,
+            config.seed + trial,
+            lambda t, row, k=trial: recorder.add(t, np.r_[k, row]),
+        )
         keep = t >= config.settle
         reference, measured = values[keep, 0], values[keep, 1]
         errors.append(float(tracking_error(reference, measured)))
         costs.append(float(tuning_cost(t[keep], reference, measured)))
     q1, median, q3 = np.percentile(errors, [25, 50, 75])
-    return {"error_median_deg": float(median), "error_q1_deg": float(q1),
-            "error_q3_deg": float(q3), "cost_median": float(np.median(costs))}  # fmt: skip
+    return {
+        "error_median_deg": float(median),
+        "error_q1_deg": float(q1),
+        "error_q3_deg": float(q3),
+        "cost_median": float(np.median(costs)),
+    }
 
 
 TUNERS = ("descent", "manual", "ziegler-nichols")
@@ -101,22 +113,38 @@ def tune_on_rig(
 
     m, level = tuning.manual, levels[0]
     if method == "descent":
-        run = auto_run(tuning, levels, index, rig(levels, tuning.auto.hold,
-                                                  auto_seed(tuning, index))).result  # fmt: skip
-        return {"method": method, "levels_deg": list(levels), "gains": run.k.tolist(),
-                "cost": run.cost, "experiments": run.evaluations,
-                "sweeps": len(run.history) - 1}  # fmt: skip
+        run = auto_run(
+            tuning, levels, index, rig(levels, tuning.auto.hold, auto_seed(tuning, index))
+        ).result
+        return {
+            "method": method,
+            "levels_deg": list(levels),
+            "gains": run.k.tolist(),
+            "cost": run.cost,
+            "experiments": run.evaluations,
+            "sweeps": len(run.history) - 1,
+        }
     if method == "manual":
         experiment = rig((level,), m.hold, manual_seed(tuning, level))
         found = manual_tuning(experiment, ManualSettings(band=m.band, tolerance=m.tolerance))
-        return {"method": method, "levels_deg": [level], "gains": found.gains.tolist(),
-                "experiments": len(found.trials),
-                "within_tolerance": found.within_tolerance}  # fmt: skip
+        return {
+            "method": method,
+            "levels_deg": [level],
+            "gains": found.gains.tolist(),
+            "experiments": len(found.trials),
+            "within_tolerance": found.within_tolerance,
+        }
     if method != "ziegler-nichols":
         raise ConfigError("--method", f"unknown tuner {method!r}; choose one of {TUNERS}")
-    ku, tu, trials = ultimate_gain(rig((level,), m.hold, m.seed + ZN_SEED_OFFSET), ZN_LADDER,
-                                   m.band)  # fmt: skip
-    return {"method": method, "levels_deg": [level], "ku": ku, "tu_s": tu,
-            "gains": ziegler_nichols(ku, tu, "PID").tolist(),
-            "gains_pi": ziegler_nichols(ku, tu, "PI").tolist(),
-            "experiments": len(trials)}  # fmt: skip
+    ku, tu, trials = ultimate_gain(
+        rig((level,), m.hold, m.seed + ZN_SEED_OFFSET), ZN_LADDER, m.band
+    )
+    return {
+        "method": method,
+        "levels_deg": [level],
+        "ku": ku,
+        "tu_s": tu,
+        "gains": ziegler_nichols(ku, tu, "PID").tolist(),
+        "gains_pi": ziegler_nichols(ku, tu, "PI").tolist(),
+        "experiments": len(trials),
+    }

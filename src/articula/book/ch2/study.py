@@ -174,8 +174,12 @@ def controllers(tuning: Tuning) -> dict[str, dict[str, Any]]:
         if kind == "ordinary":
             tables[name] = {"name": name, "schedule": "constant", "gains": single[method]}
         else:
-            tables[name] = {"name": name, "schedule": kind, "gains": scheduled[method],
-                            "points_deg": list(SUBRANGES)}  # fmt: skip
+            tables[name] = {
+                "name": name,
+                "schedule": kind,
+                "gains": scheduled[method],
+                "points_deg": list(SUBRANGES),
+            }
     return tables
 
 
@@ -203,9 +207,14 @@ def compare(study: Study, tables: Mapping[str, dict[str, Any]], done: int) -> Co
                 calibration[f] = trace
     first = configs[0]
     return Comparison(
-        table, traces, calibration, first["trials"], first["reference"]["offset_deg"],
-        first["reference"]["amplitude_deg"], float(first["plant"]["trial_spread"]),
-    )  # fmt: skip
+        table,
+        traces,
+        calibration,
+        first["trials"],
+        first["reference"]["offset_deg"],
+        first["reference"]["amplitude_deg"],
+        float(first["plant"]["trial_spread"]),
+    )
 
 
 def _tuning_figures(tuning: Tuning, out: Path) -> None:

@@ -38,9 +38,9 @@ class ManualConfig(StrictModel):
     """
 
     seed: Seed = 1000
-    hold: Positive = 10.0  # [s]
-    band: Positive = 2.0  # [°] noise band about a level
-    tolerance: Positive = 1.0  # [°] acceptable steady-state error
+    hold: Positive = 10.0
+    band: Positive = 2.0
+    tolerance: Positive = 1.0
 
 
 class AutoConfig(StrictModel):
@@ -61,12 +61,12 @@ class AutoConfig(StrictModel):
     """
 
     seed: Seed = 2000
-    hold: Positive = 4.0  # [s] per level of the reference
+    hold: Positive = 4.0
     k_stop: Positive = 0.05
     max_iterations: Annotated[int, Field(ge=1, le=10_000)] = 30
-    k0_max: GainVector = Field(default_factory=lambda: [2.0, 4.0, 0.2])  # K ~ U(0, k0_max)
-    dk0_max: GainVector = Field(default_factory=lambda: [0.5, 1.0, 0.1])  # dK ~ U(0, dk0_max)
-    upper: GainVector = Field(default_factory=lambda: [20.0, 40.0, 5.0])  # probes beyond fail
+    k0_max: GainVector = Field(default_factory=lambda: [2.0, 4.0, 0.2])
+    dk0_max: GainVector = Field(default_factory=lambda: [0.5, 1.0, 0.1])
+    upper: GainVector = Field(default_factory=lambda: [20.0, 40.0, 5.0])
 
 
 class TuningConfig(StrictModel):
@@ -226,9 +226,14 @@ class KdProbe:
 
 
 def kd_probe(
-    plant: PneuNetParams, gains: np.ndarray, levels: tuple[float, ...], hold: float,
-    kd_values: tuple[float, ...], seeds: int, band: float,
-) -> KdProbe:  # fmt: skip
+    plant: PneuNetParams,
+    gains: np.ndarray,
+    levels: tuple[float, ...],
+    hold: float,
+    kd_values: tuple[float, ...],
+    seeds: int,
+    band: float,
+) -> KdProbe:
     """M (2.5) and swings of `seeds` step experiments for the gains with K_d set to each value.
 
     Every K_d sees the same noise seeds, so differences between K_d values are paired; the

@@ -100,9 +100,10 @@ def damping_grows(peak_deg: Sequence[float | None], settling_s: Sequence[float |
     last peak at most HALVED times the first."""
     p, s = _inf(peak_deg), _inf(settling_s)
     return bool(
-        np.all(np.diff(p) <= PEAK_TOL) and np.all(np.diff(s) <= SETTLE_TOL)
+        np.all(np.diff(p) <= PEAK_TOL)
+        and np.all(np.diff(s) <= SETTLE_TOL)
         and p[-1] <= HALVED * p[0]
-    )  # fmt: skip
+    )
 
 
 def meets_book(peak_deg: float, settling_s: float) -> bool:

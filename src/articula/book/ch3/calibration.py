@@ -46,8 +46,9 @@ def calibrate(
         return base.model_copy(update={"youngs_modulus": E, "damping": b})
 
     def modulus_for(b: float) -> float:
-        return brentq(lambda E: undamped(with_(E, b))["peak_true_deg"] - peak_deg,
-                      8e3, 2e5, xtol=1.0)  # fmt: skip
+        return brentq(
+            lambda E: undamped(with_(E, b))["peak_true_deg"] - peak_deg, 8e3, 2e5, xtol=1.0
+        )
 
     lo, hi = 1e-4, 4e-3  # b [N·m·s/rad]: settles too slowly at lo, too fast at hi
     for b, slow in ((lo, True), (hi, False)):

@@ -94,12 +94,20 @@ def simulate_deactuation(config: DeactuationConfig) -> Deactuation:
         The plant's samples (every 1 ms), the sensor's samples, the bending direction and
             the deactuation instant.
     """
-    program = valve_program(config.actuator, config.side_deg, config.gauge, config.hold,
-                            config.damping)  # fmt: skip
+    program = valve_program(
+        config.actuator, config.side_deg, config.gauge, config.hold, config.damping
+    )
     return deactuate(
-        config.actuator, config.sensor, program, config.side_deg, config.hold, config.after,
-        config.dt, round(RECORD_DT / config.dt), np.random.default_rng(config.seed),
-    )  # fmt: skip
+        config.actuator,
+        config.sensor,
+        program,
+        config.side_deg,
+        config.hold,
+        config.after,
+        config.dt,
+        round(RECORD_DT / config.dt),
+        np.random.default_rng(config.seed),
+    )
 
 
 def oscillation_metrics(

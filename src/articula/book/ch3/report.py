@@ -34,19 +34,31 @@ def _model(m: ActuatorModel, f: Findings) -> list[str]:
         ("V E c = A_c r_p L_c/L [cm³/rad]", "geometry", f"{p.lever * 1e6:.3f}"),
         ("c of ε = cP [1/MPa]", "geometry and E", f"{p.strain_per_pressure * 1e6:.3f}"),
         ("I [kg·m²]", "geometry, density, 20 g sensor", f"{p.inertia:.3e}"),
-        ("E [kPa]", "**calibrated**", f"{p.youngs_modulus / 1e3:.2f} "
-         f"(datasheet 100 % modulus {DATASHEET_MODULUS / 1e3:.0f})"),
+        (
+            "E [kPa]",
+            "**calibrated**",
+            f"{p.youngs_modulus / 1e3:.2f} (datasheet 100 % modulus {DATASHEET_MODULUS / 1e3:.0f})",
+        ),
         ("b [N·m·s/rad]", "**calibrated**", f"{p.damping:.3e}"),
         ("V E k² [N·m/rad]", "from E", f"{p.stiffness:.4f}"),
-        ("ω_n, ζ of the body alone", "from the above", f"{wn:.2f} rad/s "
-         f"({wn / 2 / math.pi:.2f} Hz), {m.damping_ratio:.3f}"),
+        (
+            "ω_n, ζ of the body alone",
+            "from the above",
+            f"{wn:.2f} rad/s ({wn / 2 / math.pi:.2f} Hz), {m.damping_ratio:.3f}",
+        ),
         ("supply pressure [kPa]", "assumed", f"{p.supply / 1e3:.0f}"),
-        ("valve orifice diameter [mm], C_d", "assumed", f"{p.orifice_diameter * 1e3:g}, "
-         f"{p.discharge:g}"),
+        (
+            "valve orifice diameter [mm], C_d",
+            "assumed",
+            f"{p.orifice_diameter * 1e3:g}, {p.discharge:g}",
+        ),
         ("orifice flow_transition [Pa]", "assumed (regulariser)", f"{p.flow_transition:g}"),
-        ("valve open time to 50 % / 90 % of supply [ms]", "orifice model",
-         f"{1e3 * m.fill_half_s:.1f} / {1e3 * m.fill_90_s:.1f}"),
-    ]  # fmt: skip
+        (
+            "valve open time to 50 % / 90 % of supply [ms]",
+            "orifice model",
+            f"{1e3 * m.fill_half_s:.1f} / {1e3 * m.fill_90_s:.1f}",
+        ),
+    ]
     return [
         "### The actuator model and its calibration (Sect. 3.2.2, Figs. 3.2 and 3.7)",
         "",
@@ -125,8 +137,14 @@ def _delta(sweep: DeltaSweep, too_fast: list[bool]) -> list[str]:
         "| book peak [°] | book settling [s] |",
         "|---|---|---|---|---|---|---|",
     ]
-    columns = (sweep.delta, sweep.open_s, sweep.peak_deg, sweep.overshoot_pct,
-               sweep.settling_s, too_fast)  # fmt: skip
+    columns = (
+        sweep.delta,
+        sweep.open_s,
+        sweep.peak_deg,
+        sweep.overshoot_pct,
+        sweep.settling_s,
+        too_fast,
+    )
     for d, t_open, pk, ov, st, fast in zip(*columns, strict=True):
         book_peak, book_settling = BOOK_TEXT.get(d, ("—", "—"))
         lines.append(

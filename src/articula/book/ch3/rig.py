@@ -35,6 +35,9 @@ def run_on_rig(config: DeactuationConfig, link: Link, recorder: Recorder) -> dic
     t, bend = run_program(link, config.hold + config.after, config.seed, recorder.add)
     angle = np.radians(bend) @ bend_direction(config.side_deg)
     m = oscillation_metrics(t, angle, config.hold, np.radians(config.band_deg))
-    return {"peak_deg": float(np.degrees(m["peak"])), "overshoot_pct": 100 * m["overshoot"],
-            "settling_s": round(m["settling"], 6),
-            "deactuation_angle_deg": float(np.degrees(m["start"]))}  # fmt: skip
+    return {
+        "peak_deg": float(np.degrees(m["peak"])),
+        "overshoot_pct": 100 * m["overshoot"],
+        "settling_s": round(m["settling"], 6),
+        "deactuation_angle_deg": float(np.degrees(m["start"])),
+    }

@@ -77,21 +77,25 @@ class Directions:
 def settling_cost(delta: float, start: float, length: float, side_deg: float = 0.0) -> float:
     """Settling time [s] of the true angle for one pulse (the run length if it never settles)."""
     config = DeactuationConfig(
-        side_deg=side_deg, sensor=IDEAL,
+        side_deg=side_deg,
+        sensor=IDEAL,
         damping=DampingPolicy(delta=delta, start=start, length=length),
-    )  # fmt: skip
+    )
     s = run_metrics(simulate_deactuation(config), config.band_deg)["settling_true_s"]
     return config.after if math.isnan(s) else s
 
 
 def _descend(
-    cost: Callable[[np.ndarray], float], k0: tuple[float, ...], dk0: tuple[float, ...],
+    cost: Callable[[np.ndarray], float],
+    k0: tuple[float, ...],
+    dk0: tuple[float, ...],
     iterations: int,
-) -> DescentResult:  # fmt: skip
+) -> DescentResult:
     """Coordinate descent within [0, DELTA_MAX] for δ and [0, TIMING_MAX] for the timing."""
     upper = np.array([DELTA_MAX, TIMING_MAX, TIMING_MAX][: len(k0)])
-    return coordinate_descent(cost, np.array(k0), np.array(dk0), K_STOP, iterations,
-                              lower=np.zeros(len(k0)), upper=upper)  # fmt: skip
+    return coordinate_descent(
+        cost, np.array(k0), np.array(dk0), K_STOP, iterations, lower=np.zeros(len(k0)), upper=upper
+    )
 
 
 def _pulse(result: DescentResult, names: tuple[str, ...], peak: bool = True) -> Pulse:
@@ -117,12 +121,15 @@ def directions(policy: DampingPolicy, iterations: int) -> Directions:
     start = (policy.delta, policy.start, policy.length)
     found = _descend(lambda k: settling_cost(*k, side_deg=SIDE_DEG), start, TIMED_DK0, iterations)
     own = _pulse(found, TIMED, peak=False)
-    cases: list[tuple[float, PulseKind, DampingPolicy]] = [(s, "none", DampingPolicy())
-                                                           for s in SIDES]  # fmt: skip
+    cases: list[tuple[float, PulseKind, DampingPolicy]] = [
+        (s, "none", DampingPolicy()) for s in SIDES
+    ]
     cases += [(s, "side 0", policy) for s in SIDES]
     cases += [(SIDE_DEG, "own", own.policy)]
-    rows = tuple(DirectionRow(side, kind, outcome(damping, side_deg=side))
-                 for side, kind, damping in sorted(cases, key=lambda c: c[0]))  # fmt: skip
+    rows = tuple(
+        DirectionRow(side, kind, outcome(damping, side_deg=side))
+        for side, kind, damping in sorted(cases, key=lambda c: c[0])
+    )
     return Directions(rows, own)
 
 

@@ -98,8 +98,19 @@ def run_study(study: Study) -> Ch3Results:
     directions = searches.directions(timed.policy, iterations)
     _search_figure(study.out, book_timing, timed)
     study.progress(total, total)
-    return Ch3Results(model, sensitivity, delta, mechanism, stiffening, timing, book_timing,
-                      timed, directions, iterations, study.full)  # fmt: skip
+    return Ch3Results(
+        model,
+        sensitivity,
+        delta,
+        mechanism,
+        stiffening,
+        timing,
+        book_timing,
+        timed,
+        directions,
+        iterations,
+        study.full,
+    )
 
 
 def _delta(study: Study, configs: Sequence[Mapping[str, Any]], total: int) -> DeltaSweep:
@@ -121,8 +132,9 @@ def _delta(study: Study, configs: Sequence[Mapping[str, Any]], total: int) -> De
         trace = read_trace(study.out / DELTA, config)
         after = trace["t"] >= config["hold"]
         curves[config["damping"]["delta"]] = (
-            trace["t"][after] - config["hold"], np.degrees(trace["bend_sensor"][after]),
-        )  # fmt: skip
+            trace["t"][after] - config["hold"],
+            np.degrees(trace["bend_sensor"][after]),
+        )
     delta_study(curves, delta, result.peak_deg, result.settling_s, BOOK, study.out / "fig3_7.png")
     return result
 

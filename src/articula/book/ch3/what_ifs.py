@@ -120,9 +120,11 @@ def outcome(
     """The true-angle outcome of one deactuation of side `side_deg` [deg] with the ideal sensor
     (default: no pulse, the calibrated actuator)."""
     config = DeactuationConfig(
-        side_deg=side_deg, actuator=actuator or SixChamberParams(),
-        damping=policy or DampingPolicy(), sensor=IDEAL,
-    )  # fmt: skip
+        side_deg=side_deg,
+        actuator=actuator or SixChamberParams(),
+        damping=policy or DampingPolicy(),
+        sensor=IDEAL,
+    )
     return _outcome(run_metrics(simulate_deactuation(config), config.band_deg))
 
 
@@ -137,10 +139,15 @@ def actuator_model(p: SixChamberParams | None = None) -> ActuatorModel:
     p = p or SixChamberParams()
     wn, zeta = natural_frequency(p)
     return ActuatorModel(
-        p, wn, zeta, fill_time(p, 0.5 * p.supply), fill_time(p, 0.9 * p.supply),
-        gas_stiffness(p, p.atmosphere), gas_stiffness(p, p.atmosphere + 0.5 * p.supply),
+        p,
+        wn,
+        zeta,
+        fill_time(p, 0.5 * p.supply),
+        fill_time(p, 0.9 * p.supply),
+        gas_stiffness(p, p.atmosphere),
+        gas_stiffness(p, p.atmosphere + 0.5 * p.supply),
         _outcome(undamped(p)),
-    )  # fmt: skip
+    )
 
 
 def sensitivity() -> tuple[ValveCase, ...]:
@@ -200,6 +207,7 @@ def stiffening() -> tuple[StiffeningRow, ...]:
     rows = []
     for s in STIFFENING:
         a = SixChamberParams(stiffening=s)
-        rows.append(StiffeningRow(s, (outcome(actuator=a), outcome(BOOK_PULSE, a),
-                                      outcome(HELD_PULSE, a))))  # fmt: skip
+        rows.append(
+            StiffeningRow(s, (outcome(actuator=a), outcome(BOOK_PULSE, a), outcome(HELD_PULSE, a)))
+        )
     return tuple(rows)

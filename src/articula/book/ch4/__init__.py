@@ -24,6 +24,8 @@ def reproduce(study: Study) -> Section:
         name: {key: value if key == "k" else num(value) for key, value in m.items()}
         for name, m in results.runs.items()
     }
-    sweep = [{"k": r.k, "measured": num(r.measured), "predicted": num(r.predicted),
-              "noise_rms": r.noise} for r in results.bandwidth]  # fmt: skip
+    sweep = [
+        {"k": r.k, "measured": num(r.measured), "predicted": num(r.predicted), "noise_rms": r.noise}
+        for r in results.bandwidth
+    ]
     return Section(markdown, {**model, "runs": runs, "bandwidth": sweep}, tuple(claims))

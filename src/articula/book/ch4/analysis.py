@@ -125,9 +125,15 @@ def bandwidth_rows(
     """
     k_col = np.asarray(columns["controller.filter_order"], dtype=float)
     f_col = np.asarray(columns["reference.frequency"], dtype=float)
-    col = {name: np.asarray(columns[name], dtype=float) for name in (
-        "amplitude_ratio", "noise_rms", "current_rms_error", "saturation_fraction",
-    )}  # fmt: skip
+    col = {
+        name: np.asarray(columns[name], dtype=float)
+        for name in (
+            "amplitude_ratio",
+            "noise_rms",
+            "current_rms_error",
+            "saturation_fraction",
+        )
+    }
     lowest = float(f_col.min())
     rows = []
     for k in sorted({int(k) for k in k_col}):
@@ -135,14 +141,20 @@ def bandwidth_rows(
         freqs = np.unique(f_col[sel])
         ratio = np.array([col["amplitude_ratio"][sel & (f_col == f)].mean() for f in freqs])
         stable, predicted = linear[k]
-        rows.append(BandwidthRow(
-            k=k, frequencies=freqs, ratios=ratio,
-            measured=first_crossing(freqs, ratio, HALF_POWER),
-            predicted=predicted if stable else float("nan"), stable=stable,
-            noise=float(col["noise_rms"][sel].mean()), low_frequency=lowest,
-            error_low=float(col["current_rms_error"][sel & (f_col == lowest)].mean()),
-            saturation=float(col["saturation_fraction"][sel].max()),
-        ))  # fmt: skip
+        rows.append(
+            BandwidthRow(
+                k=k,
+                frequencies=freqs,
+                ratios=ratio,
+                measured=first_crossing(freqs, ratio, HALF_POWER),
+                predicted=predicted if stable else float("nan"),
+                stable=stable,
+                noise=float(col["noise_rms"][sel].mean()),
+                low_frequency=lowest,
+                error_low=float(col["current_rms_error"][sel & (f_col == lowest)].mean()),
+                saturation=float(col["saturation_fraction"][sel].max()),
+            )
+        )
     return rows
 
 

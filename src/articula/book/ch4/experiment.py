@@ -29,10 +29,10 @@ class CurrentReference(StrictModel):
         frequency: angular frequency of the sinusoidal part [rad/s].
     """
 
-    current: Finite = 1.0  # i_ss [A]
-    speed: Finite = 5.0  # ω_ss [rad/s], held by the secondary on the dual rig
-    amplitude: NonNegative = 0.0  # [A]
-    frequency: NonNegative = 0.0  # [rad/s]
+    current: Finite = 1.0
+    speed: Finite = 5.0
+    amplitude: NonNegative = 0.0
+    frequency: NonNegative = 0.0
 
 
 class CurrentControllerConfig(StrictModel):
@@ -45,8 +45,8 @@ class CurrentControllerConfig(StrictModel):
             [samples]; 1: unfiltered.
     """
 
-    kp: NonNegative = 10.0  # [V/A]
-    ki: NonNegative = 100.0  # [V/(A·s)]
+    kp: NonNegative = 10.0
+    ki: NonNegative = 100.0
     filter_order: Annotated[int, Field(ge=1, le=10_000)] = 1
 
 
@@ -58,8 +58,8 @@ class SpeedControllerConfig(StrictModel):
         ki: integral gain [V/rad].
     """
 
-    kp: NonNegative = 5.0  # [V·s/rad]
-    ki: NonNegative = 10.0  # [V/rad]
+    kp: NonNegative = 5.0
+    ki: NonNegative = 10.0
 
 
 class PwmConfig(StrictModel):
@@ -71,7 +71,7 @@ class PwmConfig(StrictModel):
     """
 
     bits: Annotated[int, Field(ge=0, le=16)] = 8
-    v_max: Positive = 12.0  # [V]
+    v_max: Positive = 12.0
 
 
 class CurrentControlConfig(StrictModel):
@@ -98,10 +98,10 @@ class CurrentControlConfig(StrictModel):
     seed: Seed = 0
     rig: Literal["single", "dual"] = "dual"
     preset: Literal["table4.1", "table4.2"] = "table4.2"
-    motor: MotorParams | None = None  # overrides `preset` when given
-    dt: Annotated[float, Field(gt=0, le=0.1, allow_inf_nan=False)] = 1e-3  # [s]
-    duration: Positive = 2.0  # [s]
-    settle: NonNegative = 1.0  # [s] before steady-state metrics are taken
+    motor: MotorParams | None = None
+    dt: Annotated[float, Field(gt=0, le=0.1, allow_inf_nan=False)] = 1e-3
+    duration: Positive = 2.0
+    settle: NonNegative = 1.0
     reference: CurrentReference = CurrentReference()
     controller: CurrentControllerConfig = CurrentControllerConfig()
     speed_controller: SpeedControllerConfig = SpeedControllerConfig()
@@ -169,16 +169,25 @@ def loop_settings(config: CurrentControlConfig) -> LoopSettings:
     """
     p, c = config.params, config
     return LoopSettings(
-        dt=c.dt, v_bias=feedforward_voltage(p, c.reference.current, c.reference.speed),
-        kp=c.controller.kp, ki=c.controller.ki,
-        filter_order=c.controller.filter_order, dual=c.rig == "dual",
-        kp_speed=c.speed_controller.kp, ki_speed=c.speed_controller.ki,
-        v_max=c.pwm.v_max, pwm_bits=c.pwm.bits, sensor_ideal=c.sensor.ideal,
-        sensitivity=c.sensor.sensitivity, zero_voltage=c.sensor.zero_voltage,
-        noise_sigma=c.sensor.noise_sigma, adc_bits=c.sensor.adc_bits,
-        adc_vref=c.sensor.adc_vref, encoder_cpr=0 if c.encoder.ideal else c.encoder.counts_per_rev,
+        dt=c.dt,
+        v_bias=feedforward_voltage(p, c.reference.current, c.reference.speed),
+        kp=c.controller.kp,
+        ki=c.controller.ki,
+        filter_order=c.controller.filter_order,
+        dual=c.rig == "dual",
+        kp_speed=c.speed_controller.kp,
+        ki_speed=c.speed_controller.ki,
+        v_max=c.pwm.v_max,
+        pwm_bits=c.pwm.bits,
+        sensor_ideal=c.sensor.ideal,
+        sensitivity=c.sensor.sensitivity,
+        zero_voltage=c.sensor.zero_voltage,
+        noise_sigma=c.sensor.noise_sigma,
+        adc_bits=c.sensor.adc_bits,
+        adc_vref=c.sensor.adc_vref,
+        encoder_cpr=0 if c.encoder.ideal else c.encoder.counts_per_rev,
         encoder_window=c.encoder.window,
-    )  # fmt: skip
+    )
 
 
 def time_axis(config: CurrentControlConfig) -> np.ndarray:

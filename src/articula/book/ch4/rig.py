@@ -48,15 +48,22 @@ def emulated_motor(config: CurrentControlConfig) -> MotorDevice:
 
     def plant(gains: MotorGains, reference: Program, duration: float, seed: int) -> np.ndarray:
         current, amplitude, frequency, speed = reference.values
-        run = config.model_copy(update={
-            "duration": duration, "seed": seed, "settle": min(config.settle, duration / 2),
-            "controller": config.controller.model_copy(update={
-                "kp": gains.kp, "ki": gains.ki, "filter_order": gains.filter_order}),
-            "speed_controller": config.speed_controller.model_copy(update={
-                "kp": gains.kp_speed, "ki": gains.ki_speed}),
-            "reference": CurrentReference(current=current, amplitude=amplitude,
-                                          frequency=frequency, speed=speed),
-        })  # fmt: skip
+        run = config.model_copy(
+            update={
+                "duration": duration,
+                "seed": seed,
+                "settle": min(config.settle, duration / 2),
+                "controller": config.controller.model_copy(
+                    update={"kp": gains.kp, "ki": gains.ki, "filter_order": gains.filter_order}
+                ),
+                "speed_controller": config.speed_controller.model_copy(
+                    update={"kp": gains.kp_speed, "ki": gains.ki_speed}
+                ),
+                "reference": CurrentReference(
+                    current=current, amplitude=amplitude, frequency=frequency, speed=speed
+                ),
+            }
+        )
         channels, _ = simulate_batch(run, trials=1)
         return np.column_stack([channels[name][0] for name in DEVICE_CHANNELS])
 
@@ -84,8 +91,11 @@ def firmware_motor(config: CurrentControlConfig) -> MotorPins:
         for part in name.split("."):
             value = getattr(value, part)
         if value != built:
-            raise ConfigError(name, f"the motor firmware is built for {built} (got {value}); "
-                              "change the config or firmware/src/motor.c")  # fmt: skip
+            raise ConfigError(
+                name,
+                f"the motor firmware is built for {built} (got {value}); "
+                "change the config or firmware/src/motor.c",
+            )
     motor = config.motor or PRESETS[config.preset]
     Ad, Bd = discretize(*rig_matrices(motor, config.rig == "dual"), config.dt)
     if Ad.shape[0] == 3:  # the single rig: no secondary current, V2 acts on nothing
@@ -96,8 +106,13 @@ def firmware_motor(config: CurrentControlConfig) -> MotorPins:
 def run_on_rig(config: CurrentControlConfig, link: Link, recorder: Recorder) -> dict[str, float]:
     """One run of `config` on the rig behind `link`; chapter 4's metrics of its trace."""
     c = config
-    gains = MotorGains(c.controller.kp, c.controller.ki, c.controller.filter_order,
-                       c.speed_controller.kp, c.speed_controller.ki)  # fmt: skip
+    gains = MotorGains(
+        c.controller.kp,
+        c.controller.ki,
+        c.controller.filter_order,
+        c.speed_controller.kp,
+        c.speed_controller.ki,
+    )
     r = c.reference
     program = Program(Shape.CURRENT, (r.current, r.amplitude, r.frequency, r.speed))
     link.command(Kind.SET_GAINS, gains.encode())
@@ -125,12 +140,15 @@ def trace_metrics(
     bits, v_max = config.pwm.bits, config.pwm.v_max
     v_full = v_max if bits == 0 else pwm_voltage((1 << bits) - 1, v_max, bits)
     sums = {
-        "error": e.sum(), "error_sq": (e * e).sum(), "noise_sq": (lag_free**2).sum(),
+        "error": e.sum(),
+        "error_sq": (e * e).sum(),
+        "noise_sq": (lag_free**2).sum(),
         "omega": trace.get("omega", trace["omega_meas"])[s:].sum(),
         "saturated": float(np.sum(np.abs(trace["v1"]) >= v_full)),
-        "i": i[s:].sum(), "i_sin": (i * np.sin(window.frequency * t))[s:].sum(),
+        "i": i[s:].sum(),
+        "i_sin": (i * np.sin(window.frequency * t))[s:].sum(),
         "i_cos": (i * np.cos(window.frequency * t))[s:].sum(),
-    }  # fmt: skip
+    }
     for name, y in (("", i), ("_fb", fed_back)):
         for level in (10, 90):
             sums[f"t{level}{name}"] = _first_crossing(t[:s], y[:s], window.rise_target, level)

@@ -108,13 +108,19 @@ def run_study(study: Study) -> Ch4Results:
     for name, raw in figures.items():
         _, config = parse_config(raw)
         metrics = read_metrics(study.out / RUNS, raw)
-        runs[name] = {**{k: math.nan if v is None else v for k, v in metrics.items()},
-                      "k": config.controller.filter_order}  # fmt: skip
+        runs[name] = {
+            **{k: math.nan if v is None else v for k, v in metrics.items()},
+            "k": config.controller.filter_order,
+        }
     orders = sorted(set(table["controller.filter_order"]))
     rows = bandwidth_rows(table, {k: linear_bandwidth(k) for k in orders})
     _, fig4_6 = parse_config(figures["fig4_6"])
-    gains = {"kp": fig4_6.controller.kp, "ki": fig4_6.controller.ki, "R": fig4_6.params.R,
-             "dt": fig4_6.dt}  # fmt: skip
+    gains = {
+        "kp": fig4_6.controller.kp,
+        "ki": fig4_6.controller.ki,
+        "R": fig4_6.params.R,
+        "dt": fig4_6.dt,
+    }
     model = model_numbers()
     _figures(study.out, figures, model, rows)
     return Ch4Results(model, runs, gains, rows, len(sweep))
@@ -128,13 +134,18 @@ def model_numbers() -> ModelNumbers:
     ws, is_ = simulated_steady_state(p, V, SIMULATED_SECONDS)
     _, i_load = steady_state(p, V, torque=book.LOAD_TORQUE)
     return ModelNumbers(
-        omega_per_volt=w1, current_per_volt=i1, omega_at_supply=w12, current_at_supply=i12,
-        simulated_omega=ws, simulated_current=is_, current_with_load=i_load,
+        omega_per_volt=w1,
+        current_per_volt=i1,
+        omega_at_supply=w12,
+        current_at_supply=i12,
+        simulated_omega=ws,
+        simulated_current=is_,
+        current_with_load=i_load,
         denominator=p.b * p.R + p.K**2,  # Eq. (4.8)
         omega_c=critical_speed(q, V, book.CRITICAL_CURRENT),
         stall_current=current_at_speed(q, V, 0.0),  # Eq. (4.11) at ω = 0
         no_load_speed=V / q.K,  # Eq. (4.11) at i = 0
-    )  # fmt: skip
+    )
 
 
 def simulated_steady_state(p: MotorParams, voltage: float, seconds: float) -> tuple[float, float]:
@@ -168,14 +179,23 @@ def _figures(
     q, V = TABLE_4_2, book.SUPPLY
     omega = np.linspace(0.0, model.no_load_speed, FIG4_3_POINTS)
     current = np.array([current_at_speed(q, V, w) for w in omega])
-    current_speed_line(omega, current, model.omega_c, book.CRITICAL_CURRENT,
-                       "Current against speed at 12 V (Table 4.2), Eq. (4.11)",
-                       out / "fig4_3.png")  # fmt: skip
+    current_speed_line(
+        omega,
+        current,
+        model.omega_c,
+        book.CRITICAL_CURRENT,
+        "Current against speed at 12 V (Table 4.2), Eq. (4.11)",
+        out / "fig4_3.png",
+    )
     for name, raw in figures.items():
         _, config = parse_config(raw)
         trace = read_trace(out / RUNS, raw)
         response(trace, book.FIGURES[name], out / f"{name}.png", config.pwm.bits)
-    bandwidth_tradeoff([r.k for r in rows], [r.measured for r in rows],
-                       [r.predicted for r in rows], [r.noise for r in rows],
-                       {r.k: (r.frequencies, r.ratios) for r in rows},
-                       out / "bandwidth.png")  # fmt: skip
+    bandwidth_tradeoff(
+        [r.k for r in rows],
+        [r.measured for r in rows],
+        [r.predicted for r in rows],
+        [r.noise for r in rows],
+        {r.k: (r.frequencies, r.ratios) for r in rows},
+        out / "bandwidth.png",
+    )
