@@ -21,7 +21,7 @@ import time
 import numpy as np
 from common import run
 
-from articula.book.ch4.experiment import (
+from articula.experiments.motor import (
     CurrentControlConfig,
     current_reference,
     loop_settings,

@@ -25,13 +25,13 @@ from pathlib import Path
 from common import run
 
 from articula.book.ch2.book_values import BOOK_TABLE_2_2, CONTROLLERS
-from articula.book.ch2.experiment import (
+from articula.book.study import packaged
+from articula.experiments.pneunet import (
     AngleReference,
     ControllerConfig,
     PneuNetPidConfig,
     run_pneunet_pid,
 )
-from articula.book.study import packaged
 from articula.runs.runner import run_sweep
 from articula.runs.sweep import expand_sweep
 from articula.validation import load_toml

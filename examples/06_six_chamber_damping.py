@@ -19,8 +19,8 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from articula.book.ch3.experiment import DeactuationConfig, run_deactuation
 from articula.control.damping import DampingPolicy
+from articula.experiments.six_chamber import DeactuationConfig, run_deactuation
 
 HOLD = 1.5  # [s] chamber 0 filled and held before the vent command
 RESIDUAL = (0.5, 2.0)  # [s] after the vent command: the window of the residual RMS

@@ -19,7 +19,7 @@ import control as ct
 import numpy as np
 from matplotlib.figure import Figure
 
-from articula.book.ch4.experiment import CurrentControlConfig, simulate_batch
+from articula.experiments.motor import CurrentControlConfig, simulate_batch
 from articula.plants import dc_motor
 
 VOLTAGE, TORQUE = 12.0, -0.3  # [V], [N·m]: the supply and an opposing load (Eq. 4.10)

@@ -20,10 +20,10 @@ from pydantic import BaseModel
 
 import articula.book.ch1 as ch1
 import articula.robots as robots
-from articula.book.ch2.experiment import PneuNetPidConfig
-from articula.book.ch3.experiment import DeactuationConfig
-from articula.book.ch4.experiment import CurrentControlConfig
+from articula.experiments.motor import CurrentControlConfig
 from articula.experiments.plan import PlanConfig
+from articula.experiments.pneunet import PneuNetPidConfig
+from articula.experiments.six_chamber import DeactuationConfig
 from articula.plants.dc_motor import PRESETS
 from articula.scene.config import SceneSpec
 

@@ -86,9 +86,9 @@ PRELOAD = (
     "articula.runs.records",
     "articula.scene.check",
     "articula.experiments.plan",
-    "articula.book.ch2.experiment",
-    "articula.book.ch3.experiment",
-    "articula.book.ch4.experiment",
+    "articula.experiments.pneunet",
+    "articula.experiments.six_chamber",
+    "articula.experiments.motor",
     "articula.book.ch4.motor_analysis",
     "articula.book.reproduce",
 )

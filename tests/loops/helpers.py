@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from articula.book.ch4.experiment import CurrentControlConfig
+from articula.experiments.motor import CurrentControlConfig
 from articula.validation import parse_model
 
 IDEAL = {"sensor": {"ideal": True}, "encoder": {"ideal": True}, "pwm": {"bits": 0}}

@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 from scipy.signal import cont2discrete, dlsim
 
-from articula.book.ch4.experiment import (
+from articula.control.moving_average import moving_average
+from articula.experiments.motor import (
     CurrentControlConfig,
     simulate_batch,
 )
-from articula.control.moving_average import moving_average
 from articula.plants.motor_rig import rig_matrices
 from tests.loops.helpers import IDEAL, config
 

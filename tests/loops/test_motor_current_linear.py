@@ -10,13 +10,13 @@ import control
 import numpy as np
 import pytest
 
-from articula.book.ch4.experiment import (
+from articula.control.moving_average import moving_average
+from articula.experiments.motor import (
     CurrentControlConfig,
     loop_settings,
     simulate_batch,
     time_axis,
 )
-from articula.control.moving_average import moving_average
 from articula.loops.motor_current_linear import (
     bandwidth,
     closed_loop,

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from articula.book.ch2.experiment import AngleReference, reference_deg
 from articula.book.ch2.tuning import step_reference
 from articula.errors import ConfigError, DeviceError
+from articula.experiments.pneunet import AngleReference, reference_deg
 from articula.rigs.programs import Program, Shape, steps
 
 PERIOD = 1.0 / 30.0

@@ -95,7 +95,7 @@ def emulate(
 
 def _motor_config(plant: Path | None):
     """The motor.current config of --plant (chapter 4's defaults without one)."""
-    from articula.book.ch4.experiment import CurrentControlConfig
+    from articula.experiments.motor import CurrentControlConfig
     from articula.validation import load_toml, parse_model
 
     data = {} if plant is None else load_toml(plant)

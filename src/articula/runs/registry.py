@@ -1,7 +1,7 @@
 """Experiments by name, found through the `articula.experiments` entry-point group.
 
 The run layer knows no experiment: each one is an `Experiment` object in the module that owns
-it, named in pyproject.toml (`"motor.current" = "articula.book.ch4.experiment:CURRENT_CONTROL"`).
+it, named in pyproject.toml (`"motor.current" = "articula.experiments.motor:CURRENT_CONTROL"`).
 Loading an entry point imports only that module, so there is no import cycle, and a package of
 one's own can add experiments without touching articula.
 """

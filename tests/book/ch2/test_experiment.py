@@ -1,15 +1,15 @@
-"""book/ch2/experiment.py: the pneunet.pid config, its reference and the registered run."""
+"""experiments/pneunet.py: the pneunet.pid config, its reference and the registered run."""
 
 import numpy as np
 import pytest
 
-from articula.book.ch2.experiment import (
+from articula.errors import ConfigError
+from articula.experiments.pneunet import (
     ControllerConfig,
     PneuNetPidConfig,
     reference_deg,
     run_pneunet_pid,
 )
-from articula.errors import ConfigError
 from articula.runs.registry import parse_config
 from articula.runs.runner import execute
 

@@ -7,16 +7,16 @@ import math
 import numpy as np
 import pytest
 
-from articula.book.ch3.experiment import (
+from articula.control.chamber_allocation import side_pressures
+from articula.control.damping import DampingPolicy
+from articula.errors import ConfigError
+from articula.experiments.six_chamber import (
     DeactuationConfig,
     oscillation_metrics,
     run_deactuation,
     run_metrics,
     simulate_deactuation,
 )
-from articula.control.chamber_allocation import side_pressures
-from articula.control.damping import DampingPolicy
-from articula.errors import ConfigError
 from articula.loops.six_chamber import valve_program
 from articula.plants.orientation_sensor import OrientationSensorParams
 from articula.plants.six_chamber import SixChamberParams

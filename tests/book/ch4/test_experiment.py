@@ -7,14 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from articula.book.ch4.experiment import (
+from articula.control.moving_average import moving_average
+from articula.errors import ConfigError
+from articula.experiments.motor import (
     CurrentControlConfig,
     run_current_control,
     simulate_batch,
     time_axis,
 )
-from articula.control.moving_average import moving_average
-from articula.errors import ConfigError
 from articula.validation import parse_model
 from tests.oracles import rise_time, sinusoid_fit
 

@@ -14,11 +14,11 @@ from typing import Any
 
 import numpy as np
 
-from articula.book.ch2.experiment import AngleReference, PneuNetPidConfig
 from articula.book.ch2.study import ZN_LADDER, ZN_SEED_OFFSET
 from articula.book.ch2.tuning import TuningConfig, auto_run, auto_seed, manual_seed
 from articula.control.pid import GainSchedule
 from articula.errors import ConfigError
+from articula.experiments.pneunet import AngleReference, PneuNetPidConfig
 from articula.rigs.link import Link
 from articula.rigs.pneunet import PneuNetRig, encode_gains
 from articula.rigs.programs import Program, Shape, steps

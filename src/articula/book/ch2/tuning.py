@@ -13,8 +13,8 @@ from typing import Annotated
 import numpy as np
 from pydantic import Field
 
-from articula.book.ch2.experiment import AngleReference, reference_deg
 from articula.control.pid import PID, GainSchedule
+from articula.experiments.pneunet import AngleReference, reference_deg
 from articula.loops.pneunet_pid import SimulatedRig, run_closed_loop
 from articula.plants.pneunet import PneuNetParams
 from articula.tuning.coordinate_descent import DescentResult, coordinate_descent

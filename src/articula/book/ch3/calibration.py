@@ -7,8 +7,8 @@ from dataclasses import dataclass
 from scipy.optimize import brentq
 
 from articula.book.ch3.book_values import BOOK_PEAK_DEG, BOOK_SETTLING_S
-from articula.book.ch3.experiment import DeactuationConfig, run_metrics, simulate_deactuation
 from articula.errors import ModelError
+from articula.experiments.six_chamber import DeactuationConfig, run_metrics, simulate_deactuation
 from articula.plants.orientation_sensor import OrientationSensorParams
 from articula.plants.six_chamber import SixChamberParams
 

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from articula.book.ch3.experiment import DeactuationConfig, oscillation_metrics
 from articula.control.chamber_allocation import bend_direction
+from articula.experiments.six_chamber import DeactuationConfig, oscillation_metrics
 from articula.rigs.link import Link
 from articula.rigs.programs import Program, Shape
 from articula.rigs.protocol import Info, Kind

@@ -13,9 +13,9 @@ from typing import Any, Literal
 
 import numpy as np
 
-from articula.book.ch3.experiment import DeactuationConfig, run_metrics, simulate_deactuation
 from articula.book.ch3.what_ifs import BOOK_PULSE, IDEAL, Outcome, outcome
 from articula.control.damping import DampingPolicy
+from articula.experiments.six_chamber import DeactuationConfig, run_metrics, simulate_deactuation
 from articula.tuning.coordinate_descent import DescentResult, coordinate_descent
 
 Curve = tuple[np.ndarray, np.ndarray]

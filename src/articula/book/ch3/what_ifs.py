@@ -11,8 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from articula.book.ch3.calibration import undamped
-from articula.book.ch3.experiment import DeactuationConfig, run_metrics, simulate_deactuation
 from articula.control.damping import DampingPolicy
+from articula.experiments.six_chamber import DeactuationConfig, run_metrics, simulate_deactuation
 from articula.plants.orientation_sensor import OrientationSensorParams
 from articula.plants.six_chamber import SixChamberParams, gas_stiffness, natural_frequency
 from articula.plants.six_chamber_sim import ValveSchedule, fill_time, integrate

@@ -15,16 +15,16 @@ from typing import Any
 
 import numpy as np
 
-from articula.book.ch4.experiment import (
+from articula.control.moving_average import moving_average
+from articula.control.pwm import pwm_voltage
+from articula.errors import ConfigError
+from articula.experiments.motor import (
     CurrentControlConfig,
     CurrentReference,
     metric_window,
     metrics_from_sums,
     simulate_batch,
 )
-from articula.control.moving_average import moving_average
-from articula.control.pwm import pwm_voltage
-from articula.errors import ConfigError
 from articula.plants.dc_motor import PRESETS
 from articula.plants.motor_rig import discretize, rig_matrices
 from articula.rigs.link import Link
@@ -129,7 +129,7 @@ def run_on_rig(config: CurrentControlConfig, link: Link, recorder: Recorder) -> 
 def trace_metrics(
     config: CurrentControlConfig, t: np.ndarray, trace: dict[str, np.ndarray]
 ) -> dict[str, Any]:
-    """Chapter 4's metrics (book/ch4/experiment.py) from a recorded trace: the running sums
+    """Chapter 4's metrics (experiments/motor.py) from a recorded trace: the running sums
     of loops.motor_current computed from its columns, then metrics_from_sums."""
     window = metric_window(config)
     s = window.settle_index

@@ -14,12 +14,12 @@ import numpy as np
 
 from articula.book.ch4 import book_values as book
 from articula.book.ch4.analysis import BandwidthRow, bandwidth_rows
-from articula.book.ch4.experiment import (
+from articula.book.study import Study, packaged, read_metrics, read_trace
+from articula.experiments.motor import (
     CurrentControlConfig,
     CurrentControllerConfig,
     loop_settings,
 )
-from articula.book.study import Study, packaged, read_metrics, read_trace
 from articula.loops.motor_current_linear import bandwidth, closed_loop, is_stable
 from articula.plants.dc_motor import (
     TABLE_4_1,
