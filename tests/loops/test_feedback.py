@@ -92,3 +92,16 @@ def test_a_measured_configuration_of_the_wrong_size_names_the_argument():
     with pytest.raises(ConfigError) as err:
         controller.step(ROBOT.ee_position(Q0), q_measured=np.zeros(3))
     assert err.value.field == "q_measured"
+
+
+def test_a_reset_forgets_the_last_target_and_its_lead():
+    controller = OnlineController.from_spec(SCENE, PlannerSpec(method="qp", dt=DT))
+    controller.reset(Q0)
+    far = ROBOT.ee_position(Q0) + np.array([0.0, 0.0, -0.2])
+    for _ in range(20):  # a target the arm lags, measured where it started
+        controller.step(far, q_measured=Q0)
+    assert np.linalg.norm(controller.lead) > 0
+    controller.reset(Q0)
+    assert controller.target is None and not controller.lead.any()
+    controller.step(ROBOT.ee_position(Q0), q_measured=Q0)  # no error against the old target
+    assert not controller.lead.any()

@@ -177,7 +177,7 @@ class OnlineController:
             moving = robot.check_q(velocity, "velocity")
             self.planner.follow(moving * self.dt)
         self.q, self.q_measured, self.periods = start, start.copy(), 0
-        self.lead = np.zeros(3)
+        self.lead, self.target = np.zeros(3), None  # nothing measured against yet
         return start.copy()
 
     def step(
