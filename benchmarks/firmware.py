@@ -53,9 +53,9 @@ from typing import Any
 import numpy as np
 from common import run
 
-from articula.book.ch4.rig import firmware_motor, run_on_rig
 from articula.book.study import packaged
 from articula.experiments.motor import CurrentControlConfig, simulate_batch
+from articula.experiments.motor_on_rig import firmware_motor, run_on_rig
 from articula.rigs.firmware import FirmwareRig
 from articula.rigs.firmware_checks import (
     host_loss_trial,

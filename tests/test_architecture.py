@@ -30,12 +30,12 @@ LAYERS = {
     "loops": 8,
     "runs": 9,
     "rigs": 10,
-    "experiments": 10,
-    "book": 11,
-    "bench": 11,
-    "viewer": 11,
-    "cli": 12,
-    "__main__": 13,
+    "experiments": 11,
+    "book": 12,
+    "bench": 12,
+    "viewer": 12,
+    "cli": 13,
+    "__main__": 14,
 }
 MAX_LINES = 400
 
@@ -119,6 +119,15 @@ def test_every_top_level_package_has_a_layer():
 def test_no_source_module_is_over_the_line_limit(module):
     lines = MODULES[module].read_text(encoding="utf-8").count("\n")
     assert lines <= MAX_LINES, f"{module}: {lines} lines"
+
+
+MAX_CLI_LINES = 150  # the CLI parses, calls and prints; the work lives below it
+
+
+@pytest.mark.parametrize("module", sorted(m for m in MODULES if m.startswith("articula.cli")))
+def test_no_cli_module_is_over_its_line_limit(module):
+    lines = MODULES[module].read_text(encoding="utf-8").count("\n")
+    assert lines <= MAX_CLI_LINES, f"{module}: {lines} lines; move the work below the CLI"
 
 
 # A plan is assembled once, by articula.experiments.plan.build_plan: a scene built from a

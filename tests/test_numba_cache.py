@@ -71,8 +71,8 @@ def test_cached_compiled_chain_equals_a_fresh_composition():
     compiled = CompiledClearance.build(scene)
     rng = np.random.default_rng(5)
     for q in rng.uniform(scene.robot.lower, scene.robot.upper, (20, scene.robot.nq)):
-        cached = _evaluate(q, *compiled.arrays(), compiled.static_min)
-        fresh = _evaluate.py_func(q, *compiled.arrays(), compiled.static_min)
+        cached = _evaluate(q, compiled.inputs(), compiled.static_min)
+        fresh = _evaluate.py_func(q, compiled.inputs(), compiled.static_min)
         assert cached[0] == pytest.approx(fresh[0], abs=1e-12)
         assert np.allclose(cached[2], fresh[2], atol=1e-15, rtol=0)
 

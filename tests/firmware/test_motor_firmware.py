@@ -18,10 +18,10 @@ import math
 import numpy as np
 import pytest
 
-from articula.book.ch4.rig import firmware_motor, run_on_rig, trace_metrics
 from articula.book.study import packaged
 from articula.errors import ConfigError
 from articula.experiments.motor import CurrentControlConfig, simulate_batch
+from articula.experiments.motor_on_rig import firmware_motor, run_on_rig, trace_metrics
 from articula.rigs.link import Link
 from articula.rigs.protocol import RigKind
 from articula.rigs.recorder import Recorder

@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from articula.book.ch4.rig import firmware_motor
 from articula.experiments.motor import CurrentControlConfig
+from articula.experiments.motor_on_rig import firmware_motor
 from articula.rigs.firmware import FirmwareRig
 from articula.rigs.firmware_checks import (
     WATCHDOG_S,

@@ -14,9 +14,9 @@ from pathlib import Path
 
 import pytest
 
-from articula.book.ch3.rig import CHANNELS, run_on_rig
 from articula.errors import ConfigError, DeviceError
 from articula.experiments.six_chamber import DeactuationConfig, run_deactuation
+from articula.experiments.six_chamber_on_rig import CHANNELS, run_on_rig
 from articula.plants.orientation_sensor import OrientationSensorParams
 from articula.plants.six_chamber import SixChamberParams
 from articula.rigs.link import Link

@@ -75,8 +75,7 @@ def test_a_point_closer_to_itself_than_the_margin_is_outside_omega_on_every_path
         kept, g = objective.project_and_value(q, clear, 7.0, target, 0.0)
         assert np.array_equal(kept, clear) and g == 7.0
     objective = Objective(scene, 0.0, 1.0, 0.0)
-    x_ref, orient = target.position, objective.orient_arguments(target)
     kept, g, _ = baornn_kernel._project_and_value(
-        q, clear, 7.0, 0.5, x_ref, orient, *objective.kernel_arguments()
+        q, clear, 7.0, 0.5, objective.reference(target), objective.problem()
     )
     assert np.array_equal(kept, clear) and g == 7.0

@@ -130,7 +130,7 @@ def test_rig_info_of_an_emulated_pneunet(emulated_pneunet, cli):
     [
         (["rig", "info", "/dev/no-such-rig"], "cannot open the port"),
         (["rig", "info", "/dev/null"], "cannot open the port"),
-        (["emulate", "wobble"], "no emulator for 'wobble'"),
+        (["emulate", "wobble"], "no rig called 'wobble'"),
         (["emulate", "pneunet", "--plant", "x.toml"], "only the motor rig"),
         (["emulate", "pneunet", "--faults", "drop=3"], "probability"),
         (["emulate", "motor", "--firmware", "/no/motor.elf"], "make -C firmware"),

@@ -7,10 +7,10 @@ import math
 
 import pytest
 
-from articula.book.ch4.rig import DEVICE_CHANNELS, emulated_motor, run_on_rig
 from articula.book.study import packaged
 from articula.errors import DeviceError
 from articula.experiments.motor import CurrentControlConfig, run_current_control
+from articula.experiments.motor_on_rig import DEVICE_CHANNELS, emulated_motor, run_on_rig
 from articula.rigs.emulator import Emulator
 from articula.rigs.link import Link
 from articula.rigs.protocol import RigKind

@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import pytest
 
-from articula.book.ch3.rig import CHANNELS, run_on_rig
 from articula.errors import DeviceError
 from articula.experiments.six_chamber import DeactuationConfig, run_deactuation
+from articula.experiments.six_chamber_on_rig import CHANNELS, run_on_rig
 from articula.rigs.emulator import Emulator
 from articula.rigs.link import Link
 from articula.rigs.protocol import RigKind

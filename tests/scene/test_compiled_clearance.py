@@ -122,7 +122,7 @@ def test_near_pairs_keep_every_pair_that_can_be_the_minimum_in_the_box():
         kept = compiled.near_pairs(compiled.pairs, (lower, upper))
         dropped += len(compiled.pairs) - len(kept)
         for q in rng.uniform(lower, upper, (5, ROBOT.nq)):
-            every = _evaluate(q, *compiled.arrays(), compiled.static_min)[0]
-            near_only = _evaluate(q, *compiled.arrays(kept), compiled.static_min)[0]
+            every = _evaluate(q, compiled.inputs(), compiled.static_min)[0]
+            near_only = _evaluate(q, compiled.inputs(kept), compiled.static_min)[0]
             assert near_only == pytest.approx(every, abs=1e-9)
     assert dropped >= 30 * 4 * 7  # the far spheres' pairs, at least, left every box

@@ -26,7 +26,7 @@ def cube_distance():
     eye = np.eye(3)
 
     def distance(offset, r1: float = 0.0, r2: float = 0.0) -> float:
-        args = (c.vertices, c.neighbours, c.offsets, c.hints.copy())
+        args = (c.shapes.vertices, c.shapes.neighbours, c.shapes.offsets, c.scratch.hints.copy())
         return gjk_distance(*args, k, eye, np.zeros(3), r1, k, eye, np.asarray(offset, float),
                             r2, np.zeros(7, dtype=np.int64))  # fmt: skip
 
@@ -65,8 +65,9 @@ def test_a_cached_simplex_gives_the_cold_answer_along_a_path_through_contact():
         R = np.array([[np.cos(angle), -np.sin(angle), 0.0], [np.sin(angle), np.cos(angle), 0.0],
                       [0.0, 0.0, 1.0]])  # fmt: skip
         p = np.array([1.6 - 0.8 * s, 0.9 * s, 0.3 * np.sin(5 * s)])
-        args = (c.vertices, c.neighbours, c.offsets, c.hints, k, np.eye(3), np.zeros(3), 0.0,
-                k, R, p, 0.05)  # fmt: skip
+        shapes, hints = c.shapes, c.scratch.hints
+        args = (shapes.vertices, shapes.neighbours, shapes.offsets, hints, k, np.eye(3),
+                np.zeros(3), 0.0, k, R, p, 0.05)  # fmt: skip
         warm = gjk_distance(*args, cache)
         cold = gjk_distance(*args, np.zeros(7, dtype=np.int64))
         assert warm == pytest.approx(cold, abs=1e-12)

@@ -174,37 +174,7 @@ class Baornn(BeetleSearch):
         Returns:
             The accepted joint angles, shape (nq,) [rad], and their objective g.
         """
-        target = as_target(target)
-        obj = self.objective
-        b = self.rng.standard_normal(q.size)
-        if obj.compiled is not None:
-            self.evaluations += 3
-            self.iterations += 1
-            return kernel.iterations(
-                q,
-                g,
-                target.position,
-                obj.orient_arguments(target),
-                b[None, :],
-                self.params.c1,
-                self.params.c2,
-                *obj.kernel_arguments(self._box, t, self._stop),
-            )
-        b /= math.sqrt(b @ b)  # a normalised random direction
-        lam = self.params.c1 * np.sqrt(g) if np.isfinite(g) else self.params.c1  # Eq. (1.23)
-        # Eqs. (1.15)-(1.18): antennae, projected onto Ω, evaluated by "virtual robots".
-        _, g_left = obj.project_and_value(q + lam * b, q, g, target, t, self._box, self._stop)
-        _, g_right = obj.project_and_value(q - lam * b, q, g, target, t, self._box, self._stop)
-        delta = self.params.c2 * lam  # Eq. (1.24)
-        step = q - delta * np.sign(g_left - g_right) * b  # Eq. (1.19)
-        q_new, g_new = obj.project_and_value(
-            step, q, g, target, t, self._box, self._stop
-        )  # Eq. (1.20)
-        self.evaluations += 3
-        self.iterations += 1
-        if g_new < g:  # Eqs. (1.21)-(1.22): accept only an improvement
-            return q_new, g_new
-        return q, g
+        return self._iterations(q, g, as_target(target), t, 1)
 
     def step(self, q: np.ndarray, target: Target | np.ndarray, t: float) -> np.ndarray:
         """One control period: re-evaluate g for the new target, then iterate.
@@ -218,25 +188,44 @@ class Baornn(BeetleSearch):
             The joint angles at the end of the period, shape (nq,) [rad].
         """
         target = as_target(target)
-        obj, k, start = self.objective, self.params.iterations_per_step, q
+        obj, start = self.objective, q
         begun = self._begin_period(q, target, t)
         q, g = (q, obj.value(q, target, t)) if begun is None else begun
-        if obj.compiled is not None:
-            # The same draws as k calls of iterate: the Generator fills rows in order.
-            directions = self.rng.standard_normal((k, q.size))
-            self.evaluations += 3 * k
-            self.iterations += k
-            q, g = kernel.iterations(
-                q,
-                g,
-                target.position,
-                obj.orient_arguments(target),
-                directions,
-                self.params.c1,
-                self.params.c2,
-                *obj.kernel_arguments(self._box, t, self._stop),
-            )
-            return self._end_period(start, q, g)
-        for _ in range(k):
-            q, g = self.iterate(q, g, target, t)
+        q, g = self._iterations(q, g, target, t, self.params.iterations_per_step)
         return self._end_period(start, q, g)
+
+    def _iterations(
+        self, q: np.ndarray, g: float, target: Target, t: float, k: int
+    ) -> tuple[np.ndarray, float]:
+        """k iterations of Algorithm 1 from (q, g = g(q)): in one compiled call where the
+        objective has its compiled evaluation, else one `_iteration` each; the draws are the
+        same (the Generator fills rows in order). Returns the accepted (q, g)."""
+        obj = self.objective
+        self.evaluations += 3 * k
+        self.iterations += k
+        if obj.compiled is None:
+            for _ in range(k):
+                q, g = self._iteration(q, g, target, t, self.rng.standard_normal(q.size))
+            return q, g
+        directions = self.rng.standard_normal((k, q.size))
+        problem = obj.problem(self._box, t, self._stop)
+        p = self.params
+        return kernel.iterations(q, g, obj.reference(target), directions, p.c1, p.c2, problem)
+
+    def _iteration(
+        self, q: np.ndarray, g: float, target: Target, t: float, b: np.ndarray
+    ) -> tuple[np.ndarray, float]:
+        """One iteration of Algorithm 1 in Python along the raw Gaussian draw b (the compiled
+        kernel's reference); returns the accepted (q, g)."""
+        obj, box, stop = self.objective, self._box, self._stop
+        b = b / math.sqrt(b @ b)  # a normalised random direction
+        lam = self.params.c1 * np.sqrt(g) if np.isfinite(g) else self.params.c1  # Eq. (1.23)
+        # Eqs. (1.15)-(1.18): antennae, projected onto Ω, evaluated by "virtual robots".
+        _, g_left = obj.project_and_value(q + lam * b, q, g, target, t, box, stop)
+        _, g_right = obj.project_and_value(q - lam * b, q, g, target, t, box, stop)
+        delta = self.params.c2 * lam  # Eq. (1.24)
+        step = q - delta * np.sign(g_left - g_right) * b  # Eq. (1.19)
+        q_new, g_new = obj.project_and_value(step, q, g, target, t, box, stop)  # Eq. (1.20)
+        if g_new < g:  # Eqs. (1.21)-(1.22): accept only an improvement
+            return q_new, g_new
+        return q, g

@@ -74,12 +74,20 @@ class ImprovedBaornn(BeetleSearch):
         Returns:
             The accepted joint angles, shape (nq,) [rad], and their objective g.
         """
-        target = as_target(target)
-        obj, p = self.objective, self.params
+        p = self.params
         draw = self.rng.standard_normal((q.size, min(p.pairs, q.size)))
-        if obj.compiled is not None:
-            return self._compiled(q, g, np.zeros(0), target, draw[None], t)
-        lam = p.c1 * math.sqrt(obj.tracking_error(q, target))
+        return self._search(q, g, np.zeros(0), as_target(target), draw[None], t)
+
+    def _iteration(
+        self, q: np.ndarray, g: float, target: Target, draw: np.ndarray, t: float
+    ) -> tuple[np.ndarray, float]:
+        """One iteration in Python from (q, g) with the Gaussian matrix `draw` (the compiled
+        kernel's reference); returns the accepted (q, g)."""
+        obj, p = self.objective, self.params
+        model = obj.scene.robot.model
+        box = self._box or (model.lowerPositionLimit, model.upperPositionLimit)
+        # c1·√e_k, no longer than the box is wide (as the compiled kernel)
+        lam = min(p.c1 * math.sqrt(obj.tracking_error(q, target)), kernel.antenna_cap(*box))
         # Orthonormal directions from a Gaussian matrix (columns), as many as pairs.
         directions = kernel._orthonormal_columns(draw)
         gradient = np.zeros(q.size)
@@ -140,37 +148,19 @@ class ImprovedBaornn(BeetleSearch):
         target = as_target(target)
         start = q
         p = self.params
-        if self.objective.compiled is not None:
-            # With limits the period starts where braking as hard as they allow takes it (g =
-            # inf outside Ω), and coasting, q plus the last motion, is the warm start.
-            warm = self._last_motion
-            if self._limit_period(q):
-                q = np.clip(q, *self._box)
-                warm = None if warm is None else start + warm - q
-            # The same draws as iterations_per_step calls of iterate, in one compiled call.
-            draws = self.rng.standard_normal((p.iterations_per_step, q.size, min(p.pairs, q.size)))
-            q, g = self._compiled(
-                q, math.nan, np.zeros(0) if warm is None else warm, target, draws, t
-            )
-        else:
-            # With limits the period starts at the better of braking and coasting, which is
-            # the warm start; without, at q with the warm start tried first.
-            begun = self._begin_period(q, target, t)
-            warm = self._last_motion if begun is None else None
-            q, g = (q, self.objective.value(q, target, t)) if begun is None else begun
-            if warm is not None:
-                q_warm, g_warm = self.objective.project_and_value(
-                    q + warm, q, g, target, t, self._box
-                )
-                self.evaluations += 1
-                if g_warm < g:
-                    q, g = q_warm, g_warm
-            for _ in range(p.iterations_per_step):
-                q, g = self.iterate(q, g, target, t)
+        # With limits the period starts where braking as hard as they allow takes it, and
+        # coasting, q plus the last motion, is the warm start (g = inf outside Ω).
+        warm = self._last_motion
+        if self._limit_period(q):
+            q = np.clip(q, *self._box)
+            warm = None if warm is None else start + warm - q
+        # The same draws as iterations_per_step calls of iterate.
+        draws = self.rng.standard_normal((p.iterations_per_step, q.size, min(p.pairs, q.size)))
+        q, g = self._search(q, math.nan, np.zeros(0) if warm is None else warm, target, draws, t)
         self._last_motion = q - start
         return self._end_period(start, q, g)
 
-    def _compiled(
+    def _search(
         self,
         q: np.ndarray,
         g: float,
@@ -180,21 +170,32 @@ class ImprovedBaornn(BeetleSearch):
         t: float,
     ) -> tuple[np.ndarray, float]:
         """From q with g = g(q) (NaN: computed there, inf outside Ω), a warm start (none when
-        `warm` is empty) and the iterations of `draws` by planning/baornn_kernel.py, moving
-        obstacles at time t."""
+        `warm` is empty) and one iteration per matrix of `draws`: in one compiled call
+        (planning/baornn_kernel.py) where the objective has its compiled evaluation, else in
+        Python; moving obstacles at time t. Returns the accepted (q, g)."""
         obj, p = self.objective, self.params
-        q, g, evaluations = kernel.improved_period(
-            q,
-            g,
-            warm,
-            target.position,
-            obj.orient_arguments(target),
-            draws,
-            p.c1,
-            p.c2,
-            p.short_antenna,
-            *obj.kernel_arguments(self._box, t, self._stop),
-        )
-        self.evaluations += evaluations
-        self.iterations += draws.shape[0]
+        if obj.compiled is not None:
+            q, g, evaluations = kernel.improved_period(
+                q,
+                g,
+                warm,
+                obj.reference(target),
+                draws,
+                p.c1,
+                p.c2,
+                p.short_antenna,
+                obj.problem(self._box, t, self._stop),
+            )
+            self.evaluations += evaluations
+            self.iterations += draws.shape[0]
+            return q, g
+        if math.isnan(g):  # g at q, inf outside Ω: any point inside it is better
+            g = obj.project_and_value(q, q, math.inf, target, t, (q, q), self._stop)[1]
+        if warm.size:
+            q_warm, g_warm = obj.project_and_value(q + warm, q, g, target, t, self._box, self._stop)
+            self.evaluations += 1
+            if g_warm < g:
+                q, g = q_warm, g_warm
+        for draw in draws:
+            q, g = self._iteration(q, g, target, draw, t)
         return q, g

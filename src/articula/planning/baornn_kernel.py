@@ -7,11 +7,13 @@ projection (1.17) evaluated by `_evaluate`, so one control period is one call fr
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
 from articula.numba_cache import jit
 from articula.planning.task import orientation_error
+from articula.scene.compiled_bundles import ClearanceInputs
 from articula.scene.compiled_clearance import _evaluate
 
 # Ω's floor on self clearance [m] (docs/deviations.md, self-collision). The compiled GJK and
@@ -20,6 +22,52 @@ from articula.scene.compiled_clearance import _evaluate
 # must stay clear by this margin. Here, not in objective.py, so that numba's cache of these
 # kernels sees a change of it.
 SELF_CONTACT_MARGIN = 1e-4
+
+
+class Reference(NamedTuple):
+    """A period's target as the kernels take it (Objective.reference).
+
+    Attributes:
+        position: x_r, shape (3,) [m].
+        task: the task's code (Task.code: 0 for a position task).
+        weight: w of the orientation term [m/rad].
+        tool_axis: the tool axis of an axis task, shape (3,) (end-effector frame).
+        rotation: the reference rotation of a pose task, shape (3, 3).
+        axis: the reference axis of an axis task, shape (3,) (world).
+    """
+
+    position: np.ndarray
+    task: int
+    weight: float
+    tool_axis: np.ndarray
+    rotation: np.ndarray
+    axis: np.ndarray
+
+
+class Problem(NamedTuple):
+    """g's weights and Ω as the kernels take them (Objective.problem).
+
+    Attributes:
+        lambda_weight: penalty weight Λ of Eq. (1.7) [m^(1+β)].
+        beta: penalty exponent β of Eq. (1.7).
+        d_min: hard clearance of Eq. (1.12) [m].
+        self_d_min: hard clearance between the links of a checked pair [m].
+        lower: lower bound of the projection box, shape (nq,) [rad].
+        upper: upper bound of the projection box, shape (nq,) [rad].
+        stop: the braking check (objective.Stop: q_base, change, sweep).
+        clearance: the compiled scene with the pairs that count.
+        static_min: smallest distance of the pairs that never move, per kind, shape (2,) [m].
+    """
+
+    lambda_weight: float
+    beta: float
+    d_min: float
+    self_d_min: float
+    lower: np.ndarray
+    upper: np.ndarray
+    stop: tuple
+    clearance: ClearanceInputs
+    static_min: np.ndarray
 
 
 @jit()
@@ -41,19 +89,20 @@ def outside_omega(d: float, d_self: float, d_min: float, self_d_min: float) -> b
 
 
 @jit()
-def _task_error(ee, ee_R, x_ref, orient):  # fmt: skip
-    """||x_r − f(θ)|| (Eq. 1.5), plus weight · orientation error for a pose or axis task;
-    orient = (task code, weight, tool axis, reference rotation, reference axis)."""
+def _task_error(ee, ee_R, reference):
+    """||x_r − f(θ)|| (Eq. 1.5), plus weight · orientation error for a pose or axis task."""
+    x_ref = reference.position
     ex, ey, ez = x_ref[0] - ee[0], x_ref[1] - ee[1], x_ref[2] - ee[2]
     e = math.sqrt(ex * ex + ey * ey + ez * ez)
-    kind, weight, tool_axis, R_ref, axis_ref = orient
-    if kind != 0:
-        e += weight * orientation_error(kind, tool_axis, ee_R, R_ref, axis_ref)
+    if reference.task != 0:
+        e += reference.weight * orientation_error(
+            reference.task, reference.tool_axis, ee_R, reference.rotation, reference.axis
+        )
     return e
 
 
 @jit()
-def stoppable(clipped, d, d_self, d_min, self_d_min, stop, arrays, static_min):  # fmt: skip
+def stoppable(clipped, d, d_self, d_min, self_d_min, stop, clearance, static_min):
     """Whether the arm, at `clipped` after this period's motion from stop's q_base, still ends
     in Ω if every joint then brakes at its largest deceleration (the point where it stops is
     evaluated only when the clearances left could be used up on the way).
@@ -64,11 +113,10 @@ def stoppable(clipped, d, d_self, d_min, self_d_min, stop, arrays, static_min): 
         d_self: its clearance between checked link pairs [m].
         d_min: the hard clearance of Eq. (1.12) [m].
         self_d_min: the hard clearance between the links of a checked pair [m].
-        stop: (q_base, the period's start, shape (nq,) [rad]; change, each joint's largest
-            change of motion per period, shape (nq,) [rad], empty: no acceleration limit;
-            sweep, how far a shape point moves at most per unit of each joint's motion, shape
-            (nq,) [m/rad]).
-        arrays: compiled scene arrays with the pairs that count (CompiledClearance.arrays).
+        stop: the braking check (objective.Stop: q_base, the period's start; change, each
+            joint's largest change of motion per period, empty: no acceleration limit; sweep,
+            how far a shape point moves at most per unit of each joint's motion).
+        clearance: the compiled scene with the pairs that count.
         static_min: smallest distance of the pairs that never move, per kind, shape (2,) [m].
 
     Returns:
@@ -87,31 +135,35 @@ def stoppable(clipped, d, d_self, d_min, self_d_min, stop, arrays, static_min): 
     room = min(d - d_min, d_self - max(self_d_min, SELF_CONTACT_MARGIN))
     if room > travel:
         return True
-    d_stop, d_self_stop, _, _ = _evaluate(q_stop, *arrays, static_min)
+    d_stop, d_self_stop, _, _ = _evaluate(q_stop, clearance, static_min)
     return not outside_omega(d_stop, d_self_stop, d_min, self_d_min)
 
 
 @jit()
-def _project_and_value(
-    q, q_current, g_current, e_current, x_ref, orient, lambda_weight, beta, d_min, self_d_min,
-    lower, upper, stop, arrays, static_min,
-):  # fmt: skip
-    """(P_Ω(q), g there, the task error e there), Eqs. (1.17)-(1.18); stays at (q_current,
-    g_current, e_current) when the clipped point is outside Ω (outside_omega) or, with
-    acceleration limits, cannot brake inside it (stoppable). The pairs in `arrays` are the
-    ones that count (an obstacle clearance of +inf: none)."""
-    clipped = np.minimum(np.maximum(q, lower), upper)
-    d, d_self, ee, ee_R = _evaluate(clipped, *arrays, static_min)
-    if outside_omega(d, d_self, d_min, self_d_min) or not stoppable(
-        clipped, d, d_self, d_min, self_d_min, stop, arrays, static_min
-    ):
-        return q_current, g_current, e_current
-    e = _task_error(ee, ee_R, x_ref, orient)  # Eq. (1.5), with the orientation term
-    return clipped, _penalised(e, d, lambda_weight, beta), e
+def _braking_clear(q, d, d_self, problem):
+    """stoppable with the problem's Ω and braking check."""
+    p = problem
+    return stoppable(q, d, d_self, p.d_min, p.self_d_min, p.stop, p.clearance, p.static_min)
 
 
 @jit()
-def _penalised(e, d, lambda_weight, beta):  # fmt: skip
+def _project_and_value(q, q_current, g_current, e_current, reference, problem):
+    """(P_Ω(q), g there, the task error e there), Eqs. (1.17)-(1.18); stays at (q_current,
+    g_current, e_current) when the clipped point is outside Ω (outside_omega) or, with
+    acceleration limits, cannot brake inside it (stoppable). The pairs in the problem's
+    clearance are the ones that count (an obstacle clearance of +inf: none)."""
+    clipped = np.minimum(np.maximum(q, problem.lower), problem.upper)
+    d, d_self, ee, ee_R = _evaluate(clipped, problem.clearance, problem.static_min)
+    if outside_omega(d, d_self, problem.d_min, problem.self_d_min) or not _braking_clear(
+        clipped, d, d_self, problem
+    ):
+        return q_current, g_current, e_current
+    e = _task_error(ee, ee_R, reference)  # Eq. (1.5), with the orientation term
+    return clipped, _penalised(e, d, problem.lambda_weight, problem.beta), e
+
+
+@jit()
+def _penalised(e, d, lambda_weight, beta):
     """g = e + Λ/d^β (Eq. 1.7), e alone without a penalty or an obstacle to count."""
     if lambda_weight > 0.0 and d < np.inf:
         return e + lambda_weight / d**beta if d > 0.0 else np.inf
@@ -119,29 +171,17 @@ def _penalised(e, d, lambda_weight, beta):  # fmt: skip
 
 
 @jit()
-def iterations(
-    q, g, x_ref, orient, directions, c1, c2, lambda_weight, beta, d_min, self_d_min,
-    lower, upper, stop, arrays, static_min,
-):  # fmt: skip
+def iterations(q, g, reference, directions, c1, c2, problem):
     """Run one iteration of Algorithm 1 per row of `directions`; returns the accepted (q, g).
 
     Args:
         q: joint angles, shape (nq,) [rad].
         g: objective g(q) there.
-        x_ref: reference position, shape (3,) [m].
-        orient: the task's orientation arguments (Objective.orient_arguments).
+        reference: the period's target (Reference).
         directions: raw Gaussian draws, one row per iteration, normalised here, shape (k, nq).
         c1: antenna length constant of Eq. (1.23) [rad/√m].
         c2: step constant of Eq. (1.24).
-        lambda_weight: penalty weight Λ of Eq. (1.7) [m^(1+β)].
-        beta: penalty exponent β of Eq. (1.7).
-        d_min: hard clearance of Eq. (1.12) [m].
-        self_d_min: hard clearance between the links of a checked pair [m].
-        lower: lower bound of the projection box, shape (nq,) [rad].
-        upper: upper bound of the projection box, shape (nq,) [rad].
-        stop: the braking check's (q_base, change, reach), see `stoppable`.
-        arrays: compiled scene arrays with the pairs that count (CompiledClearance.arrays).
-        static_min: smallest distance of the pairs that never move, per kind, shape (2,) [m].
+        problem: g's weights and Ω (Problem).
 
     Returns:
         The accepted joint angles, shape (nq,) [rad], and their objective g.
@@ -149,18 +189,12 @@ def iterations(
     for k in range(directions.shape[0]):
         b = directions[k] / math.sqrt(directions[k] @ directions[k])
         lam = c1 * math.sqrt(g) if math.isfinite(g) else c1  # Eq. (1.23)
-        _, g_left, _ = _project_and_value(q + lam * b, q, g, 0.0, x_ref, orient, lambda_weight,
-                                          beta, d_min, self_d_min, lower, upper, stop, arrays,
-                                          static_min)  # fmt: skip
-        _, g_right, _ = _project_and_value(q - lam * b, q, g, 0.0, x_ref, orient, lambda_weight,
-                                           beta, d_min, self_d_min, lower, upper, stop, arrays,
-                                           static_min)  # fmt: skip
+        _, g_left, _ = _project_and_value(q + lam * b, q, g, 0.0, reference, problem)
+        _, g_right, _ = _project_and_value(q - lam * b, q, g, 0.0, reference, problem)
         diff = g_left - g_right
         sign = 1.0 if diff > 0.0 else (-1.0 if diff < 0.0 else 0.0)  # 0 when both are inf
         step = q - c2 * lam * sign * b  # Eqs. (1.19), (1.24)
-        q_new, g_new, _ = _project_and_value(step, q, g, 0.0, x_ref, orient, lambda_weight,
-                                             beta, d_min, self_d_min, lower, upper, stop, arrays,
-                                             static_min)  # fmt: skip
+        q_new, g_new, _ = _project_and_value(step, q, g, 0.0, reference, problem)
         if g_new < g:  # Eqs. (1.21)-(1.22)
             q, g = q_new, g_new
     return q, g
@@ -201,7 +235,7 @@ def antenna_scale(pair: int, short: float) -> float:
 
 
 @jit()
-def _orthonormal_columns(draw):  # fmt: skip
+def _orthonormal_columns(draw):
     """The columns of `draw` (n × m, m ≤ n) made orthonormal by Gram-Schmidt, as rows: the Q
     of its QR up to the signs of its columns (which only swap an antenna pair's ends)."""
     out = np.ascontiguousarray(draw.T)
@@ -213,58 +247,43 @@ def _orthonormal_columns(draw):  # fmt: skip
 
 
 @jit()
-def improved_period(
-    q, g_known, warm_motion, x_ref, orient, draws, c1, c2, short, lambda_weight, beta, d_min,
-    self_d_min, lower, upper, stop, arrays, static_min,
-):  # fmt: skip
+def improved_period(q, g_known, warm_motion, reference, draws, c1, c2, short, problem):
     """One control period of baornn-improved (planning/baornn_improved.py): g at q for the
-    new reference (inf outside Ω; g_known instead when it is not NaN: a caller's g(q)), the warm
-    start
-    q + warm_motion (none when it is empty), then one iteration per draws[k], an
+    new reference (inf outside Ω; g_known instead when it is not NaN: a caller's g(q)), the
+    warm start q + warm_motion (none when it is empty), then one iteration per draws[k], an
     (n × pairs) Gaussian matrix whose orthonormalised columns are the antenna directions.
 
     Args:
         q: joint angles at the start of the period, shape (nq,) [rad].
         g_known: the caller's g(q), or NaN to compute it here.
         warm_motion: last period's joint motion, shape (nq,) [rad]; empty for no warm start.
-        x_ref: reference position, shape (3,) [m].
-        orient: the task's orientation arguments (Objective.orient_arguments).
+        reference: the period's target (Reference).
         draws: Gaussian draws, one matrix per iteration, shape (k, nq, pairs).
         c1: antenna length constant, λ_k = c1·√e_k [rad/√m].
         c2: step constant of Eq. (1.24).
         short: relative length of every second antenna pair.
-        lambda_weight: penalty weight Λ of Eq. (1.7) [m^(1+β)].
-        beta: penalty exponent β of Eq. (1.7).
-        d_min: hard clearance of Eq. (1.12) [m].
-        self_d_min: hard clearance between the links of a checked pair [m].
-        lower: lower bound of the projection box, shape (nq,) [rad].
-        upper: upper bound of the projection box, shape (nq,) [rad].
-        stop: the braking check's (q_base, change, reach), see `stoppable`.
-        arrays: compiled scene arrays with the pairs that count (CompiledClearance.arrays).
-        static_min: smallest distance of the pairs that never move, per kind, shape (2,) [m].
+        problem: g's weights and Ω (Problem).
 
     Returns:
         The accepted joint angles, shape (nq,) [rad], their objective g, and the number of
         objective evaluations.
     """
-    d, d_self, ee, ee_R = _evaluate(q, *arrays, static_min)
-    e = _task_error(ee, ee_R, x_ref, orient)
-    g = _penalised(e, d, lambda_weight, beta) if math.isnan(g_known) else g_known
+    d, d_self, ee, ee_R = _evaluate(q, problem.clearance, problem.static_min)
+    e = _task_error(ee, ee_R, reference)
+    g = _penalised(e, d, problem.lambda_weight, problem.beta) if math.isnan(g_known) else g_known
     if math.isnan(g_known) and (
-        outside_omega(d, d_self, d_min, self_d_min)
-        or not stoppable(q, d, d_self, d_min, self_d_min, stop, arrays, static_min)
+        outside_omega(d, d_self, problem.d_min, problem.self_d_min)
+        or not _braking_clear(q, d, d_self, problem)
     ):
         g = math.inf  # a start outside Ω: any point inside it is better
     evaluations = 0
     if warm_motion.size:
-        q_warm, g_warm, e_warm = _project_and_value(q + warm_motion, q, g, e, x_ref, orient,
-                                                    lambda_weight, beta, d_min, self_d_min, lower,
-                                                    upper, stop, arrays, static_min)  # fmt: skip
+        q_warm, g_warm, e_warm = _project_and_value(q + warm_motion, q, g, e, reference, problem)
         evaluations += 1
         if g_warm < g:
             q, g, e = q_warm, g_warm, e_warm
     n = q.size
-    cap = antenna_cap(lower, upper)
+    cap = antenna_cap(problem.lower, problem.upper)
     for k in range(draws.shape[0]):
         lam = min(c1 * math.sqrt(e), cap)  # c1·√e_k, e_k the task error at the accepted q
         directions = _orthonormal_columns(draws[k])
@@ -274,11 +293,11 @@ def improved_period(
             b = directions[j]
             scale = antenna_scale(j, short)
             q_left, g_left, e_left = _project_and_value(
-                q + scale * lam * b, q, g, e, x_ref, orient, lambda_weight, beta, d_min,
-                self_d_min, lower, upper, stop, arrays, static_min)  # fmt: skip
+                q + scale * lam * b, q, g, e, reference, problem
+            )
             q_right, g_right, e_right = _project_and_value(
-                q - scale * lam * b, q, g, e, x_ref, orient, lambda_weight, beta, d_min,
-                self_d_min, lower, upper, stop, arrays, static_min)  # fmt: skip
+                q - scale * lam * b, q, g, e, reference, problem
+            )
             evaluations += 2
             if math.isfinite(g_left) and math.isfinite(g_right):
                 gradient += (g_left - g_right) / scale * b
@@ -289,9 +308,7 @@ def improved_period(
         norm = math.sqrt(gradient @ gradient)
         if norm > 0.0:
             step = q - c2 * lam * gradient / norm  # Eq. (1.19) along the estimated gradient
-            q_new, g_new, e_new = _project_and_value(step, q, g, e, x_ref, orient, lambda_weight,
-                                                     beta, d_min, self_d_min, lower, upper, stop,
-                                                     arrays, static_min)  # fmt: skip
+            q_new, g_new, e_new = _project_and_value(step, q, g, e, reference, problem)
             evaluations += 1
             if g_new < best_g:  # Eqs. (1.21)-(1.22)
                 best_q, best_g, best_e = q_new, g_new, e_new

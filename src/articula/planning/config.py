@@ -257,7 +257,7 @@ def _planner(spec: PlannerSpec, scene: Scene, seed: int) -> Planner:
             safety=spec.safety,
             speed_scale=spec.velocity_scale,
         )
-        return QpIk(scene, spec.dt, qp, spec.d_min, task, rate=rate)
+        return QpIk(scene, spec.dt, qp, d_min=spec.d_min, task=task, rate=rate)
     velocity = VelocityIkParams(
         gain=spec.gain,
         damping=spec.damping,
@@ -265,7 +265,7 @@ def _planner(spec: PlannerSpec, scene: Scene, seed: int) -> Planner:
         influence=spec.influence,
         speed_scale=spec.velocity_scale,
     )
-    return VelocityIk(scene, spec.method, spec.dt, velocity, spec.d_min, task, rate=rate)
+    return VelocityIk(scene, spec.method, spec.dt, velocity, d_min=spec.d_min, task=task, rate=rate)
 
 
 def rate_limits(spec: PlannerSpec, robot: RobotModel) -> RateLimits | None:

@@ -8,10 +8,15 @@ from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
-import pinocchio as pin
 
 from articula.errors import ConfigError, ModelError
-from articula.planning.baornn_kernel import outside_omega, stoppable
+from articula.planning.baornn_kernel import Problem, Reference, outside_omega
+from articula.planning.evaluation import (
+    CompiledEvaluation,
+    SceneEvaluation,
+    braking_travel,
+    evaluation_for,
+)
 from articula.planning.task import Target, Task, as_target, target_arrays
 from articula.robots.sweep import joint_sweep
 from articula.scene.compiled_clearance import CompiledClearance
@@ -64,23 +69,23 @@ class Objective:
     d_min: float = 0.0
     use_compiled: bool = True
     task: Task = field(default_factory=Task)
-    # The compiled evaluation of the same objective, when allowed and the scene permits it
-    # (static obstacles, revolute joints, no cylinders, GJK metric); None: Scene (Pinocchio +
-    # coal) is used.
-    compiled: CompiledClearance | None = field(init=False, default=None, repr=False)
+    evaluation: CompiledEvaluation | SceneEvaluation = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         for name in ("lambda_weight", "beta", "d_min"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value >= 0):
                 raise ConfigError(f"Objective.{name}", f"must be finite and >= 0 (got {value})")
-        if self.use_compiled:
-            object.__setattr__(self, "compiled", CompiledClearance.build(self.scene))
+        object.__setattr__(self, "evaluation", evaluation_for(self.scene, self.use_compiled))
 
-    def kernel_arguments(
-        self, box: Box | None = None, t: float = 0.0, stop: Stop = NO_STOP
-    ) -> tuple:
-        """The objective's arguments to planning.baornn_kernel (requires `compiled`).
+    @property
+    def compiled(self) -> CompiledClearance | None:
+        """The compiled evaluation's arrays, where the scene allows it (revolute joints, no
+        cylinders, GJK metric) and `use_compiled`; None: the Scene (Pinocchio + coal)."""
+        return self.evaluation.compiled
+
+    def problem(self, box: Box | None = None, t: float = 0.0, stop: Stop = NO_STOP) -> Problem:
+        """g's weights and Ω as planning.baornn_kernel takes them (requires `compiled`).
 
         Args:
             box: projection box (lower, upper), each shape (nq,) [rad]; None: the joint limits.
@@ -88,8 +93,8 @@ class Objective:
             stop: the period's braking check; NO_STOP: none.
 
         Returns:
-            (Λ, β, d_min, self_d_min, lower, upper, stop, the compiled scene arrays with the
-            pairs that count, their static minima), in the order of planning.baornn_kernel.
+            The problem, its clearance holding only the pairs that count (far ones pruned
+            from a period's box).
         """
         robot, c = self.scene.robot, self.compiled
         if c is None:
@@ -100,17 +105,8 @@ class Objective:
             # A period's reach, and where braking from it ends: far obstacles drop out.
             pairs = c.near_pairs(pairs, _braking_box(box, stop))
         lower, upper = box or (robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
-        return (
-            self.lambda_weight,
-            self.beta,
-            self.d_min,
-            self.self_d_min,
-            lower,
-            upper,
-            tuple(stop),
-            c.arrays(pairs),
-            static_min,
-        )
+        return Problem(self.lambda_weight, self.beta, self.d_min, self.self_d_min, lower, upper,
+                       stop, c.inputs(pairs), static_min)  # fmt: skip
 
     @cached_property
     def sweep(self) -> np.ndarray:
@@ -129,27 +125,19 @@ class Objective:
         then no link-obstacle distance is computed at all."""
         return bool(self.scene.obstacles) and (self.lambda_weight > 0 or self.d_min > 0)
 
-    def orient_arguments(self, target: Target) -> tuple:
-        """The task and the target's orientation as planning.baornn_kernel takes them.
+    def reference(self, target: Target) -> Reference:
+        """A period's target as planning.baornn_kernel takes it.
 
         Args:
             target: the period's target.
 
         Returns:
-            (task code, weight, tool axis, reference rotation, reference axis).
+            Its position, the task's code, weight and tool axis, and the reference rotation
+            and axis.
         """
         R_ref, axis_ref = target_arrays(self.task, target)
-        return (self.task.code, self.task.weight, self.task.tool_axis, R_ref, axis_ref)
-
-    def kinematics_arguments(self) -> tuple:
-        """The compiled scene arrays without any pair: forward kinematics only.
-
-        Returns:
-            The arguments of the compiled evaluation after q, with no pair to check.
-        """
-        if self.compiled is None:
-            raise ModelError("this scene has no compiled evaluation (see Objective.compiled)")
-        return self.compiled.arrays(self.compiled.no_pairs)
+        t = self.task
+        return Reference(target.position, t.code, t.weight, t.tool_axis, R_ref, axis_ref)
 
     def value(self, q: np.ndarray, target: Target | np.ndarray, t: float = 0.0) -> float:
         """Objective g at configuration q [rad] for the target (or a position [m]).
@@ -163,12 +151,8 @@ class Objective:
             The objective g; inf inside an obstacle when Λ > 0.
         """
         target = as_target(target)
-        if self.compiled is not None:
-            self.compiled.at(t)
-            d, _, ee, ee_R = self.compiled.evaluate(q, self.needs_obstacles, False)
-            return self._combine(self._task_error(target, ee, ee_R), d)
-        d = self.scene.clearances(q, t)[0] if self.needs_obstacles else np.inf
-        return self._value(q, target, d)
+        d, _, ee, ee_R = self.evaluation.measure(q, t, self.needs_obstacles, False)
+        return self._combine(self._task_error(target, ee, ee_R), d)
 
     def tracking_error(self, q: np.ndarray, target: Target | np.ndarray) -> float:
         """The task term of g alone: ||x_r − f(θ)||, Eq. (1.5), plus the weighted
@@ -181,14 +165,8 @@ class Objective:
         Returns:
             The task error e [m].
         """
-        target = as_target(target)
-        if self.compiled is not None:
-            _, _, ee, ee_R = self.compiled.evaluate(q, False, False)
-            return self._task_error(target, ee, ee_R)
-        robot = self.scene.robot
-        robot.forward(q)
-        placement = robot.data.oMf[robot.ee_frame_id]
-        return self._task_error(target, placement.translation, placement.rotation)
+        _, _, ee, ee_R = self.evaluation.measure(q, None, False, False)
+        return self._task_error(as_target(target), ee, ee_R)
 
     def project_and_value(
         self,
@@ -221,56 +199,15 @@ class Objective:
         """
         target = as_target(target)
         clipped = self.scene.robot.clip(q) if box is None else np.clip(q, *box)
-        if self.compiled is not None:
-            self.compiled.at(t)
-            d, d_self, ee, ee_R = self.compiled.evaluate(clipped, self.needs_obstacles)
-            if outside_omega(d, d_self, self.d_min, self.self_d_min) or not self._stoppable(
-                clipped, d, d_self, stop, t
-            ):
-                return q_current, g_current
-            return clipped, self._combine(self._task_error(target, ee, ee_R), d)
-        if not (self.needs_obstacles or self.scene.self_pairs):
-            return clipped, self._value(clipped, target, np.inf)
-        d, d_self = self.scene.clearances(clipped, t)
-        if not self.needs_obstacles:
-            d = np.inf
+        d, d_self, ee, ee_R = self.evaluation.measure(clipped, t, self.needs_obstacles, True)
         if outside_omega(d, d_self, self.d_min, self.self_d_min):
             return q_current, g_current
-        if stop.change.size:
-            d_end = self._stoppable(clipped, d, d_self, stop, t)
-            self.scene.robot.forward(clipped)  # the braking check moved the placements
-            if not d_end:
-                return q_current, g_current
-        return clipped, self._value(clipped, target, d, kinematics_done=True)
-
-    def _stoppable(self, q: np.ndarray, d: float, d_self: float, stop: Stop, t: float) -> bool:
-        """baornn_kernel.stoppable at q with clearances (d, d_self) [m], compiled or through
-        the Scene (which evaluates the point where braking ends in any case)."""
-        if not stop.change.size:
-            return True
-        c = self.compiled
-        if c is not None:
-            pairs, static_min = c.select(self.needs_obstacles, True)
-            return stoppable(
-                q, d, d_self, self.d_min, self.self_d_min, tuple(stop), c.arrays(pairs), static_min
-            )
-        q_stop = q + braking_travel(q - stop.q_base, stop.change)
-        d_stop, d_self_stop = self.scene.clearances(q_stop, t)
-        if not self.needs_obstacles:
-            d_stop = np.inf
-        return not outside_omega(d_stop, d_self_stop, self.d_min, self.self_d_min)
-
-    def _value(
-        self, q: np.ndarray, target: Target, d: float, kinematics_done: bool = False
-    ) -> float:
-        robot = self.scene.robot
-        if kinematics_done:
-            # min_distance ran the forward kinematics: only the end-effector frame is missing.
-            pin.updateFramePlacement(robot.model, robot.data, robot.ee_frame_id)
-        else:
-            robot.forward(q)
-        placement = robot.data.oMf[robot.ee_frame_id]
-        return self._combine(self._task_error(target, placement.translation, placement.rotation), d)
+        omega = (self.d_min, self.self_d_min, self.needs_obstacles)
+        if stop.change.size and not self.evaluation.brakes_clear(
+            clipped, d, d_self, stop, t, omega
+        ):
+            return q_current, g_current
+        return clipped, self._combine(self._task_error(target, ee, ee_R), d)
 
     def _task_error(self, target: Target, ee: np.ndarray, ee_R: np.ndarray) -> float:
         """||x_r − f(θ)|| [m] (Eq. 1.5), plus w · orientation error for a pose or axis task."""
@@ -287,22 +224,6 @@ class Objective:
             # Eq. (1.7): inside an obstacle the penalty has no finite value.
             g += self.lambda_weight / d**self.beta if d > 0 else np.inf
         return g
-
-
-def braking_travel(motion: np.ndarray, change: np.ndarray) -> np.ndarray:
-    """How far [rad] each joint moves on, after a period's `motion`, when it brakes at its
-    largest change of motion per period `change` (m·|m|/(2c), 0 where c is inf).
-
-    Args:
-        motion: the joint motion over the period, shape (nq,) [rad].
-        change: the largest change of motion per period, a·dt², shape (nq,) [rad].
-
-    Returns:
-        The signed travel until each joint stops, shape (nq,) [rad].
-    """
-    with np.errstate(divide="ignore", invalid="ignore"):
-        travel = motion * np.abs(motion) / (2.0 * change)
-    return np.where(np.isfinite(change), travel, 0.0)
 
 
 def _braking_box(box: Box, stop: Stop) -> Box:

@@ -12,12 +12,9 @@ import numpy as np
 from pydantic import model_validator
 
 from articula.numba_cache import jit
-from articula.planning.clearance import RowSource
-from articula.planning.rate_limits import RateLimits
-from articula.planning.reference_velocity import RateParams, task_rows
+from articula.planning.reference_velocity import RateParams
 from articula.planning.resolved_rate import ResolvedRate
-from articula.planning.task import Target, Task, as_target
-from articula.scene.scene import Scene
+from articula.planning.task import Target
 from articula.validation import NonNegative, field_error
 
 UNLIMITED = 1e3  # [rad/s] the solver's bound on a joint speed no limit bounds
@@ -87,21 +84,8 @@ class QpIk(ResolvedRate):
             limit could not hold.
     """
 
-    scene: Scene
     dt: float
     params: QpIkParams = field(default_factory=QpIkParams)
-    d_min: float = 0.0
-    task: Task = field(default_factory=Task)
-    use_compiled: bool = True
-    rate: RateLimits | None = None
-    iterations: int = field(default=0, init=False)
-    infeasible: int = field(default=0, init=False)
-    _previous: Target | None = field(default=None, init=False)
-    _rows: RowSource = field(init=False, repr=False)
-
-    def __post_init__(self) -> None:
-        self._rows = RowSource(self.scene, self.use_compiled)
-        self._set_limits(self.params.speed_scale)
 
     def step(self, q: np.ndarray, target: Target | np.ndarray, t: float) -> np.ndarray:
         """One period: solve for q̇ within this period's box (brake if the QP has no
@@ -116,11 +100,7 @@ class QpIk(ResolvedRate):
             The joint angles after dt, within the joint limits, shape (nq,) [rad].
         """
         robot, p, n = self.scene.robot, self.params, self.scene.robot.nq
-        target = as_target(target)
-        box = self._box(q)
-        ee, rows = self._rows(q, t, p.influence)
-        J, v = task_rows(ee.x, ee.R, ee.J, self.task, target, self._previous, self.dt, p.gain)
-        self._previous = target
+        box, rows, J, v = self._begin(q, target, t)
         # A joint without a speed limit still gets a finite bound for the solver [rad/s].
         qdot_low, qdot_high = (np.clip((b - q) / self.dt, -UNLIMITED, UNLIMITED) for b in box)
         model = robot.model

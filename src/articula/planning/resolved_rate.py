@@ -4,34 +4,62 @@ keeps d_min and self_d_min."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 
 from articula.planning.clearance import ClearanceRows, RowSource
-from articula.planning.objective import braking_travel
+from articula.planning.evaluation import braking_travel
 from articula.planning.planner import WARM_UP_STEPS
 from articula.planning.rate_limits import RateLimits
-from articula.planning.task import Target
+from articula.planning.reference_velocity import task_rows
+from articula.planning.task import Target, Task, as_target
 from articula.scene.scene import Scene
 
 BACKTRACKS = 3  # halvings of a step that breaks a clearance before the arm brakes instead
 
 
+@dataclass
 class ResolvedRate:
-    """A base for the resolved-rate planners: their limits, measured motion and clearance check.
+    """A base for the resolved-rate planners: the scene, the clearance they keep, their task
+    and limits, their counts, and what each period starts with (the reachable box, the rows
+    near an obstacle, the task's rows) and ends with (the clearance check).
 
-    The subclasses are dataclasses that hold `scene`, `dt`, `d_min`, `rate`, `infeasible`,
-    `_previous` and `_rows`, and call `_set_limits` after construction; this base reads them.
+    A subclass declares its own `dt` and `params` (with `influence`, `gain` and
+    `speed_scale`) and its `step`.
+
+    Attributes:
+        scene: the robot, its obstacles and its checked link pairs.
+        d_min: hard minimum clearance (Eq. 1.12) the start and every step keep [m].
+        task: what the end effector tracks.
+        use_compiled: take distances and kinematics from CompiledClearance where possible.
+        rate: joint speed and acceleration limits; None: the URDF's speeds times
+            params.speed_scale.
+        iterations: control periods computed so far.
+        infeasible: periods that braked because no motion kept the clearances, or whose
+            limits could not all hold.
     """
 
     scene: Scene
-    dt: float
-    d_min: float
-    rate: RateLimits | None
-    iterations: int
-    infeasible: int
-    _previous: Target | None
-    _rows: RowSource
-    _limits: RateLimits
+    d_min: float = field(default=0.0, kw_only=True)
+    task: Task = field(default_factory=Task, kw_only=True)
+    use_compiled: bool = field(default=True, kw_only=True)
+    rate: RateLimits | None = field(default=None, kw_only=True)
+    iterations: int = field(default=0, init=False)
+    infeasible: int = field(default=0, init=False)
+    _previous: Target | None = field(default=None, init=False, repr=False)
+    _rows: RowSource = field(init=False, repr=False)
+    _limits: RateLimits = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self._rows = RowSource(self.scene, self.use_compiled)
+        if self.rate is None:
+            speeds = self.scene.robot.velocity_limit
+            self._limits = RateLimits(
+                self.params.speed_scale * np.where(speeds > 0, speeds, np.inf), self.dt
+            )
+        else:
+            self._limits = self.rate
 
     def reset(self) -> None:
         """Forget the previous target and motion: no feed-forward, the arm at rest."""
@@ -75,14 +103,20 @@ class ResolvedRate:
         """
         raise NotImplementedError
 
-    def _set_limits(self, speed_scale: float) -> None:
-        """The limits the steps keep: `rate`, or without it the URDF's speed limits times
-        speed_scale (the solvers always keep those)."""
-        if self.rate is None:
-            speeds = self.scene.robot.velocity_limit
-            self._limits = RateLimits(speed_scale * np.where(speeds > 0, speeds, np.inf), self.dt)
-        else:
-            self._limits = self.rate
+    def _begin(
+        self, q: np.ndarray, target: Target | np.ndarray, t: float
+    ) -> tuple[tuple[np.ndarray, np.ndarray], ClearanceRows, np.ndarray, np.ndarray]:
+        """What a period starts with at q [rad]: (the box it can reach, the clearance rows
+        within the influence distance, the task Jacobian and the task velocity it asks for);
+        the target is remembered for the next period's feed-forward."""
+        target = as_target(target)
+        box = self._box(q)
+        ee, rows = self._rows(q, t, self.params.influence)
+        J, v = task_rows(
+            ee.x, ee.R, ee.J, self.task, target, self._previous, self.dt, self.params.gain
+        )
+        self._previous = target
+        return box, rows, J, v
 
     def _box(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The configurations this period can reach from q [rad] within every limit."""

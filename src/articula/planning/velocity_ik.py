@@ -8,12 +8,11 @@ from typing import Literal
 
 import numpy as np
 
-from articula.planning.clearance import ClearanceRows, RowSource
-from articula.planning.rate_limits import ROUND_OFF, RateLimits
-from articula.planning.reference_velocity import RateParams, task_rows
+from articula.planning.clearance import ClearanceRows
+from articula.planning.rate_limits import ROUND_OFF
+from articula.planning.reference_velocity import RateParams
 from articula.planning.resolved_rate import ResolvedRate
-from articula.planning.task import Target, Task, as_target
-from articula.scene.scene import Scene
+from articula.planning.task import Target
 from articula.validation import NonNegative
 
 PINV_CUTOFF = 1e-6
@@ -58,22 +57,9 @@ class VelocityIk(ResolvedRate):
             limits could not all hold.
     """
 
-    scene: Scene
     method: Literal["pinv", "dls"]
     dt: float
     params: VelocityIkParams = field(default_factory=VelocityIkParams)
-    d_min: float = 0.0
-    task: Task = field(default_factory=Task)
-    use_compiled: bool = True
-    rate: RateLimits | None = None
-    iterations: int = field(default=0, init=False)
-    infeasible: int = field(default=0, init=False)
-    _previous: Target | None = field(default=None, init=False)
-    _rows: RowSource = field(init=False, repr=False)
-
-    def __post_init__(self) -> None:
-        self._rows = RowSource(self.scene, self.use_compiled)
-        self._set_limits(self.params.speed_scale)
 
     def step(self, q: np.ndarray, target: Target | np.ndarray, t: float) -> np.ndarray:
         """One period: integrate q̇ for dt within the period's box.
@@ -87,11 +73,7 @@ class VelocityIk(ResolvedRate):
             The joint angles after dt, within the joint limits, shape (nq,) [rad].
         """
         robot, p = self.scene.robot, self.params
-        target = as_target(target)
-        box = self._box(q)
-        ee, rows = self._rows(q, t, p.influence)
-        J, v = task_rows(ee.x, ee.R, ee.J, self.task, target, self._previous, self.dt, p.gain)
-        self._previous = target
+        box, rows, J, v = self._begin(q, target, t)
         m = J.shape[0]
         # Singular values below 1e-6 of the largest are round-off (the stretched home pose has
         # 1e-13): inverting them would let the last bits of q choose the direction of motion.

@@ -82,7 +82,8 @@ class MotorGains:
 
 
 # The plant behind an emulated rig: (gains, reference program, duration [s], seed) -> the
-# channels of MEASURED + EMULATED, one row per control period (book/ch4/rig.py makes one).
+# channels of MEASURED + EMULATED, one row per control period (experiments/motor_on_rig.py
+# makes one).
 Plant = Callable[[MotorGains, Program, float, int], np.ndarray]
 
 

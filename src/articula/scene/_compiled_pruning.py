@@ -12,30 +12,12 @@ from articula.scene.compiled_poses import _apply, _capsule_gaps, _joint_poses, _
 
 
 @jit()
-def _pair_bounds(
-    q,
-    parents,
-    joint_rot,
-    joint_p,
-    axes,
-    q_index,
-    vertices,
-    starts,
-    radii,
-    shape_joint,
-    shape_rot,
-    shape_p,
-    capsule_a,
-    capsule_b,
-    capsule_r,
-    pairs,
-):
+def _pair_bounds(q, chain, shapes, pairs):
     """(lower, upper) bounds of every pair's distance at q: its capsules' gap, and the gap
     between the balls of radius r around one core point of each shape."""
-    oR, op = _joint_poses(q, parents, joint_rot, joint_p, axes, q_index)
-    world_R, world_p, ends = _shape_poses(
-        oR, op, shape_joint, shape_rot, shape_p, capsule_a, capsule_b, pairs
-    )
+    oR, op = _joint_poses(q, chain)
+    world_R, world_p, ends = _shape_poses(oR, op, shapes, pairs)
+    vertices, starts, radii = shapes.vertices, shapes.starts, shapes.radii
     upper = np.empty(pairs.shape[0])
     point_a = np.empty(3)
     point_b = np.empty(3)
@@ -45,52 +27,15 @@ def _pair_bounds(
         _apply(world_R[b], world_p[b], vertices[starts[b]], point_b)
         gap = point_a - point_b
         upper[k] = math.sqrt(gap @ gap) - radii[a] - radii[b]
-    return _capsule_gaps(ends, capsule_r, pairs), upper
+    return _capsule_gaps(ends, shapes.capsule_r, pairs), upper
 
 
 @jit()
-def _near_pairs(
-    lower,
-    upper,
-    reach,
-    static_min,
-    parents,
-    joint_rot,
-    joint_p,
-    axes,
-    q_index,
-    vertices,
-    starts,
-    radii,
-    shape_joint,
-    shape_rot,
-    shape_p,
-    capsule_a,
-    capsule_b,
-    capsule_r,
-    pairs,
-):
+def _near_pairs(lower, upper, reach, static_min, chain, shapes, pairs):
     """CompiledClearance.near_pairs in one compiled call (it runs once per control period)."""
     centre = (lower + upper) / 2.0
     delta = reach * np.sum(upper - lower) / 2.0
-    below, above = _pair_bounds(
-        centre,
-        parents,
-        joint_rot,
-        joint_p,
-        axes,
-        q_index,
-        vertices,
-        starts,
-        radii,
-        shape_joint,
-        shape_rot,
-        shape_p,
-        capsule_a,
-        capsule_b,
-        capsule_r,
-        pairs,
-    )
+    below, above = _pair_bounds(centre, chain, shapes, pairs)
     ceiling = static_min
     for k in range(pairs.shape[0]):
         if pairs[k, 3] == 0 and above[k] < ceiling:

@@ -14,15 +14,13 @@ come out apart.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import ClassVar
-
 import numpy as np
 import pinocchio as pin
 
 from articula.numba_cache import jit
 from articula.scene._compiled_arrays import _capsule_ends, _core, _edges, _pair_rows, _reach
 from articula.scene._compiled_pruning import _near_pairs
+from articula.scene.compiled_bundles import Chain, ClearanceInputs, Scratch, Shapes
 from articula.scene.compiled_poses import (
     _ee_pose,
     _joint_poses,
@@ -41,73 +39,43 @@ _AXES = {"JointModelRX": (1.0, 0.0, 0.0), "JointModelRY": (0.0, 1.0, 0.0),
          "JointModelRZ": (0.0, 0.0, 1.0)}  # fmt: skip
 
 
-@dataclass(frozen=True)
 class CompiledClearance:
-    """Arrays of a Scene for `evaluate`: kinematic chain, shape cores, capsules and pairs.
+    """A Scene as arrays for `evaluate`: kinematic chain, shape cores, capsules and pairs.
 
-    Attributes:
-        parents: parent joint index of each joint, shape (joints,); joint 0 is the world.
-        joint_rot: rotation of each joint's placement in its parent joint frame, (joints, 3, 3).
-        joint_p: position of each joint's placement in its parent joint frame, (joints, 3) [m].
-        axes: revolute axis of each joint in its own frame, shape (joints, 3) (unit vectors).
-        q_index: index of each joint's angle in q, shape (joints,).
-        ee_joint: the joint the end-effector frame moves with.
-        ee_p: end-effector origin in its joint frame, shape (3,) [m].
-        ee_rot: end-effector orientation in its joint frame, shape (3, 3).
-        vertices: core vertices of every shape in its own frame, concatenated, (total, 3) [m].
-        starts: where each shape's vertices start in `vertices`, shape (shapes + 1,).
-        neighbours: vertices joined by a hull edge, CSR by vertex (indices into `vertices`).
-        offsets: CSR offsets of each vertex's neighbours, shape (total + 1,).
-        hints: vertex each shape's support search starts from, shape (shapes,) (scratch).
-        simplices: each pair's GJK warm start (gjk.py), shape (pairs, 7) (scratch).
-        memory: each pair's last exact distance [m] and the two shapes' poses (R, p) then,
-            shape (pairs, 25) (scratch; distance −inf: none yet).
-        extents: largest |x| of a core vertex in its shape's frame, shape (shapes,) [m].
-        radii: radius swept around each core (sphere, capsule; 0 for a polytope), (shapes,) [m].
-        shape_joint: the joint each shape moves with, shape (shapes,) (0: the world).
-        shape_rot: rotation of each shape in its joint frame (world for obstacles), (shapes, 3, 3).
-        shape_p: position of each shape in its joint frame (world for obstacles), (shapes, 3) [m].
-        capsule_a: first end of each bounding capsule's segment, shape frame, (shapes, 3) [m].
-        capsule_b: second end of each bounding capsule's segment, shape frame, (shapes, 3) [m].
-        capsule_r: radius of each bounding capsule, shape (shapes,) [m].
-        pairs: rows (shape a, shape b, cache row, OBSTACLE | SELF, cell) of the pairs that move,
-            shape (pairs, 5).
+    Not frozen: `scratch` changes at every evaluation, and a moving obstacle's pose in
+    `shapes` at every `at(t)`.
+
+    Args:
+        chain: the kinematic chain (never changes).
+        shapes: the link shapes, then the obstacle parts.
+        pairs: rows (shape a, shape b, scratch row, OBSTACLE | SELF, cell) of the pairs that
+            move, shape (pairs, 5).
+        rows: how many scratch rows the pairs use (moving and fixed).
         cells: number of cells: (link, obstacle) cells row-major, then the checked link pairs.
-        static_min: smallest distance of the pairs that never move, per kind, shape (2,) [m].
         reach: no shape point is farther than this from any joint origin, in any pose [m].
         moving_parts: (shape index, its obstacle) of each part of a moving obstacle.
+
+    Attributes:
+        scratch: what the evaluations remember (GJK warm starts, the pairs' last bounds).
+        static_min: smallest distance of the pairs that never move, per kind, shape (2,) [m]
+            (+inf until `build` measures them).
     """
 
-    parents: np.ndarray
-    joint_rot: np.ndarray
-    joint_p: np.ndarray
-    axes: np.ndarray
-    q_index: np.ndarray
-    ee_joint: int
-    ee_p: np.ndarray
-    ee_rot: np.ndarray
-    vertices: np.ndarray
-    starts: np.ndarray
-    neighbours: np.ndarray
-    offsets: np.ndarray
-    hints: np.ndarray
-    simplices: np.ndarray
-    memory: np.ndarray
-    # at that time (mutable scratch; distance −inf: none yet)
-    extents: np.ndarray
-    radii: np.ndarray
-    shape_joint: np.ndarray
-    shape_rot: np.ndarray
-    shape_p: np.ndarray
-    capsule_a: np.ndarray
-    capsule_b: np.ndarray
-    capsule_r: np.ndarray
-    pairs: np.ndarray
-    cells: int
-    static_min: np.ndarray
-    reach: float
-    moving_parts: tuple[tuple[int, object], ...] = ()
-    _selected: dict = field(default_factory=dict, repr=False)  # select's answers, by kinds
+    def __init__(
+        self,
+        chain: Chain,
+        shapes: Shapes,
+        pairs: np.ndarray,
+        rows: int,
+        cells: int,
+        reach: float,
+        moving_parts: tuple[tuple[int, object], ...] = (),
+    ) -> None:
+        self.chain, self.shapes, self.pairs, self.cells = chain, shapes, pairs, cells
+        self.reach, self.moving_parts = reach, moving_parts
+        self.scratch = Scratch.fresh(shapes.starts, rows)
+        self.static_min = np.full(2, np.inf)
+        self._selected: dict = {}  # select's answers, by kinds
 
     @classmethod
     def build(cls, scene: Scene) -> CompiledClearance | None:
@@ -167,40 +135,38 @@ class CompiledClearance:
         index = {pair: k for k, pair in enumerate(pairs)}
         fixed = [pair for pair in pairs if pair not in moving]
         placements = model.jointPlacements
-        out = cls(
+        ee_frame = model.frames[scene.robot.ee_frame_id]
+        chain = Chain(
             parents=np.array(model.parents, dtype=np.int64),
             joint_rot=np.array([placements[j].rotation for j in range(model.njoints)]),
             joint_p=np.array([placements[j].translation for j in range(model.njoints)]),
             axes=axes,
             q_index=np.array(model.idx_qs, dtype=np.int64),
-            ee_joint=int(model.frames[scene.robot.ee_frame_id].parentJoint),
-            ee_p=np.array(model.frames[scene.robot.ee_frame_id].placement.translation),
-            ee_rot=np.array(model.frames[scene.robot.ee_frame_id].placement.rotation),
+            ee_joint=int(ee_frame.parentJoint),
+            ee_p=np.array(ee_frame.placement.translation),
+            ee_rot=np.array(ee_frame.placement.rotation),
+        )
+        shape_arrays = Shapes(
             vertices=np.concatenate([c[0] for c in cores] or [np.zeros((0, 3))]),
             starts=starts,
             neighbours=neighbours,
             offsets=offsets,
-            hints=starts[:-1].copy(),
-            simplices=np.zeros((len(pairs), 7), dtype=np.int64),
-            memory=np.full((len(pairs), 25), -np.inf),
             extents=np.array([np.max(np.linalg.norm(c[0], axis=1)) for c in cores]),
             radii=np.array([c[1] for c in cores], dtype=float),
-            shape_joint=np.array(joints, dtype=np.int64),
-            shape_rot=np.array([T[:3, :3] for T in poses]).reshape(-1, 3, 3),
-            shape_p=np.array([T[:3, 3] for T in poses]).reshape(-1, 3),
+            joint=np.array(joints, dtype=np.int64),
+            rot=np.array([T[:3, :3] for T in poses]).reshape(-1, 3, 3),
+            p=np.array([T[:3, 3] for T in poses]).reshape(-1, 3),
             capsule_a=np.array([b[0] for b in bounds]).reshape(-1, 3),
             capsule_b=np.array([b[1] for b in bounds]).reshape(-1, 3),
             capsule_r=np.array([b[2] for b in bounds], dtype=float),
-            pairs=_pair_rows(moving, index),
-            cells=cell_count,
-            static_min=np.full(2, np.inf),
-            reach=_reach(placements, poses[:n_links], cores[:n_links]),
-            moving_parts=tuple(moving_parts),
         )
+        reach = _reach(placements, poses[:n_links], cores[:n_links])
+        out = cls(chain, shape_arrays, _pair_rows(moving, index), len(pairs), cell_count, reach,
+                  tuple(moving_parts))  # fmt: skip
         if fixed:
-            q0 = np.zeros(model.nq)
-            static = _evaluate(q0, *out.arrays(_pair_rows(fixed, index)), np.full(2, np.inf))
-            object.__setattr__(out, "static_min", np.array(static[:2]))
+            inputs = out.inputs(_pair_rows(fixed, index))
+            static = _evaluate(np.zeros(model.nq), inputs, np.full(2, np.inf))
+            out.static_min = np.array(static[:2])
         return out
 
     def at(self, t: float) -> None:
@@ -211,10 +177,7 @@ class CompiledClearance:
             t: time [s].
         """
         for shape, obstacle in self.moving_parts:
-            _place(shape, obstacle.pose_at(t), self.shape_rot, self.shape_p, self.extents,
-                   self.memory, self.pairs)  # fmt: skip
-
-    no_pairs: ClassVar[np.ndarray] = np.zeros((0, 5), dtype=np.int64)  # kinematics only
+            _place(shape, obstacle.pose_at(t), self.shapes, self.scratch.memory, self.pairs)
 
     def evaluate(
         self, q: np.ndarray, obstacles: bool = True, self_pairs: bool = True
@@ -233,7 +196,7 @@ class CompiledClearance:
             end-effector rotation, shape (3, 3)).
         """
         pairs, static_min = self.select(obstacles, self_pairs)
-        return _evaluate(q, *self.arrays(pairs), static_min)
+        return _evaluate(q, self.inputs(pairs), static_min)
 
     def select(self, obstacles: bool, self_pairs: bool) -> tuple[np.ndarray, np.ndarray]:
         """(pairs, static_min) of the kinds asked for; the others count as +inf (read-only:
@@ -269,50 +232,39 @@ class CompiledClearance:
         Returns:
             The rows kept, shape (k', 5).
         """
-        return _near_pairs(box[0], box[1], self.reach, self.static_min[OBSTACLE], self.parents,
-                           self.joint_rot, self.joint_p, self.axes, self.q_index, self.vertices,
-                           self.starts, self.radii, self.shape_joint, self.shape_rot,
-                           self.shape_p, self.capsule_a, self.capsule_b, self.capsule_r,
-                           pairs)  # fmt: skip
+        return _near_pairs(box[0], box[1], self.reach, self.static_min[OBSTACLE], self.chain,
+                           self.shapes, pairs)  # fmt: skip
 
-    def arrays(self, pairs: np.ndarray | None = None) -> tuple:
-        """The arguments of the compiled evaluation after q (all but static_min).
+    def inputs(self, pairs: np.ndarray | None = None) -> ClearanceInputs:
+        """What the compiled evaluation reads, after q and before static_min.
 
         Args:
             pairs: the pair rows to evaluate, shape (k, 5); None for all of `pairs`.
 
         Returns:
-            The arrays, in `_evaluate`'s order, ending with the pair rows.
+            The chain, shapes, scratch and pair rows.
         """
         pairs = self.pairs if pairs is None else pairs
-        return (self.parents, self.joint_rot, self.joint_p, self.axes, self.q_index,
-                self.ee_joint, self.ee_p, self.ee_rot, self.vertices, self.starts, self.neighbours,
-                self.offsets, self.hints, self.simplices, self.memory, self.extents, self.radii,
-                self.shape_joint, self.shape_rot, self.shape_p, self.capsule_a, self.capsule_b,
-                self.capsule_r, pairs)  # fmt: skip
+        return ClearanceInputs(self.chain, self.shapes, self.scratch, pairs)
 
 
 @jit()
-def _place(shape, T, shape_rot, shape_p, extents, memory, pairs):  # fmt: skip
+def _place(shape, T, shapes, memory, pairs):
     """Put an obstacle's shape at pose T (4×4, world), lowering the remembered bound of each
     of its pairs by how far it moved."""
     R, p = np.ascontiguousarray(T[:3, :3]), np.ascontiguousarray(T[:3, 3])
-    before = np.concatenate((shape_rot[shape].ravel(), shape_p[shape])).reshape(1, 12)
-    moved = _moved(before, 0, 0, R.reshape(1, 3, 3), p.reshape(1, 3), 0, extents[shape])
+    before = np.concatenate((shapes.rot[shape].ravel(), shapes.p[shape])).reshape(1, 12)
+    moved = _moved(before, 0, 0, R.reshape(1, 3, 3), p.reshape(1, 3), 0, shapes.extents[shape])
     if moved > 0.0:
         for k in range(pairs.shape[0]):
             if pairs[k, 1] == shape:
                 memory[pairs[k, 2], 0] -= moved
-        shape_rot[shape] = R
-        shape_p[shape] = p
+        shapes.rot[shape] = R
+        shapes.p[shape] = p
 
 
 @jit()
-def _evaluate(
-    q, parents, joint_rot, joint_p, axes, q_index, ee_joint, ee_p, ee_rot, vertices, starts,
-    neighbours, offsets, hints, simplices, memory, extents, radii, shape_joint, shape_rot,
-    shape_p, capsule_a, capsule_b, capsule_r, pairs, static_min,
-):  # fmt: skip
+def _evaluate(q, inputs, static_min):
     """(obstacle clearance, self clearance, end-effector position, end-effector rotation):
     forward kinematics, shape poses, lower bounds, then exact GJK in order of bound, skipping
     a pair whose bound is not below the best distance of its kind (the broad phase of Scene).
@@ -321,16 +273,18 @@ def _evaluate(
     it out) less how far each shape has moved since: a search evaluates nearby
     configurations, so a far pair is measured once, not at every evaluation. Its capsules'
     gap is taken only when that is not enough, and remembered when it rules the pair out."""
-    oR, op = _joint_poses(q, parents, joint_rot, joint_p, axes, q_index)
-    ee, ee_R = _ee_pose(oR, op, ee_joint, ee_p, ee_rot)
-    world_R, world_p, ends = _shape_poses(oR, op, shape_joint, shape_rot, shape_p, capsule_a,
-                                          capsule_b, pairs, False)  # fmt: skip
+    chain, shapes, pairs = inputs.chain, inputs.shapes, inputs.pairs
+    memory, simplices = inputs.scratch.memory, inputs.scratch.simplices
+    oR, op = _joint_poses(q, chain)
+    ee, ee_R = _ee_pose(oR, op, chain)
+    world_R, world_p, ends = _shape_poses(oR, op, shapes, pairs, False)
     npairs = pairs.shape[0]
     lower = np.empty(npairs)
     has_obstacle = has_self = False  # a kind without pairs here cannot improve
     for k in range(npairs):
-        lower[k] = _remembered_bound(memory, pairs[k, 2], pairs[k, 0], pairs[k, 1], world_R,
-                                     world_p, extents, shape_joint)  # fmt: skip
+        lower[k] = _remembered_bound(
+            memory, pairs[k, 2], pairs[k, 0], pairs[k, 1], world_R, world_p, shapes
+        )
         if pairs[k, 3] == 1:
             has_self = True
         else:
@@ -354,15 +308,16 @@ def _evaluate(
             continue
         a, b = pairs[k, 0], pairs[k, 1]
         row = memory[pairs[k, 2]]
-        _place_ends(a, world_R, world_p, capsule_a, capsule_b, ends)
-        _place_ends(b, world_R, world_p, capsule_a, capsule_b, ends)
+        _place_ends(a, world_R, world_p, shapes, ends)
+        _place_ends(b, world_R, world_p, shapes, ends)
         gap = _segment_distance(ends[a, 0], ends[a, 1], ends[b, 0], ends[b, 1])
-        gap -= capsule_r[a] + capsule_r[b]
+        gap -= shapes.capsule_r[a] + shapes.capsule_r[b]
         if gap >= best:
             if gap > bound:
                 _remember(row, gap, world_R[a], world_p[a], world_R[b], world_p[b])
             continue
-        d = gjk_distance(vertices, neighbours, offsets, hints,
+        radii = shapes.radii
+        d = gjk_distance(shapes.vertices, shapes.neighbours, shapes.offsets, inputs.scratch.hints,
                          a, world_R[a], world_p[a], radii[a],
                          b, world_R[b], world_p[b], radii[b], simplices[pairs[k, 2]])  # fmt: skip
         _remember(row, d, world_R[a], world_p[a], world_R[b], world_p[b])

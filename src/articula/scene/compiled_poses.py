@@ -97,8 +97,10 @@ def _segment_distance(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.nda
 
 
 @jit()
-def _joint_poses(q, parents, joint_rot, joint_p, axes, q_index):
-    """World rotation and origin of every joint frame at q (joint 0: the world)."""
+def _joint_poses(q, chain):
+    """World rotation and origin of every joint frame of `chain` (a Chain) at q (joint 0:
+    the world)."""
+    parents, joint_rot, joint_p, axes = chain.parents, chain.joint_rot, chain.joint_p, chain.axes
     nj = parents.size
     oR = np.empty((nj, 3, 3))
     op = np.empty((nj, 3))
@@ -108,14 +110,15 @@ def _joint_poses(q, parents, joint_rot, joint_p, axes, q_index):
     for j in range(1, nj):
         parent = parents[j]
         _compose(oR[parent], op[parent], joint_rot[j], joint_p[j], placed, op[j])
-        _rotate_about(placed, axes[j], q[q_index[j]], oR[j])
+        _rotate_about(placed, axes[j], q[chain.q_index[j]], oR[j])
     return oR, op
 
 
 @jit()
-def _ee_pose(oR, op, ee_joint, ee_p, ee_rot):
+def _ee_pose(oR, op, chain):
     """The end effector's world position and rotation from its joint's pose and its
     placement (ee_rot, ee_p) in that joint's frame."""
+    ee_joint, ee_p, ee_rot = chain.ee_joint, chain.ee_p, chain.ee_rot
     ee = np.empty(3)
     _apply(oR[ee_joint], op[ee_joint], ee_p, ee)
     ee_R = np.empty((3, 3))
@@ -124,13 +127,11 @@ def _ee_pose(oR, op, ee_joint, ee_p, ee_rot):
 
 
 @jit()
-def _shape_poses(
-    oR, op, shape_joint, shape_rot, shape_p, capsule_a, capsule_b, pairs, ends_too=True
-):
+def _shape_poses(oR, op, shapes, pairs, ends_too=True):
     """World pose of every shape of `pairs` and (with ends_too; else unset, see _place_ends)
     the ends of its bounding capsule's segment (the other shapes' rows are left unset: a far
     obstacle costs nothing here)."""
-    ns = shape_joint.size
+    ns = shapes.joint.size
     world_R = np.empty((ns, 3, 3))
     world_p = np.empty((ns, 3))
     ends = np.empty((ns, 2, 3))
@@ -139,18 +140,18 @@ def _shape_poses(
         for s in (pairs[k, 0], pairs[k, 1]):
             if not done[s]:
                 done[s] = True
-                j = shape_joint[s]
-                _compose(oR[j], op[j], shape_rot[s], shape_p[s], world_R[s], world_p[s])
+                j = shapes.joint[s]
+                _compose(oR[j], op[j], shapes.rot[s], shapes.p[s], world_R[s], world_p[s])
                 if ends_too:
-                    _place_ends(s, world_R, world_p, capsule_a, capsule_b, ends)
+                    _place_ends(s, world_R, world_p, shapes, ends)
     return world_R, world_p, ends
 
 
 @jit()
-def _place_ends(s, world_R, world_p, capsule_a, capsule_b, ends):
+def _place_ends(s, world_R, world_p, shapes, ends):
     """ends[s] = the world ends of shape s's bounding capsule segment."""
-    _apply(world_R[s], world_p[s], capsule_a[s], ends[s, 0])
-    _apply(world_R[s], world_p[s], capsule_b[s], ends[s, 1])
+    _apply(world_R[s], world_p[s], shapes.capsule_a[s], ends[s, 0])
+    _apply(world_R[s], world_p[s], shapes.capsule_b[s], ends[s, 1])
 
 
 @jit()
@@ -181,16 +182,16 @@ def _moved(memory, row, at, world_R, world_p, s, extent):
 
 
 @jit()
-def _remembered_bound(memory, row, a, b, world_R, world_p, extents, shape_joint):
+def _remembered_bound(memory, row, a, b, world_R, world_p, shapes):
     """The last lower bound of a pair (memory[row]: an exact distance or a capsule gap) less
     how far its shapes a and b moved since: a lower bound of its distance now (−inf before
     the first). A shape on joint 0 (an obstacle) has not moved: CompiledClearance.at charges
     an obstacle's motion to its pairs' memory when it puts it at a new pose."""
     if memory[row, 0] == -np.inf:
         return -np.inf
-    bound = memory[row, 0] - _moved(memory, row, 1, world_R, world_p, a, extents[a])
-    if shape_joint[b] != 0:
-        bound -= _moved(memory, row, 13, world_R, world_p, b, extents[b])
+    bound = memory[row, 0] - _moved(memory, row, 1, world_R, world_p, a, shapes.extents[a])
+    if shapes.joint[b] != 0:
+        bound -= _moved(memory, row, 13, world_R, world_p, b, shapes.extents[b])
     return bound
 
 

@@ -49,42 +49,15 @@ def clearance_rows(
         linear rows [m/rad] then angular rows; distances, shape (rows,) [m]; gradients ∂d/∂q,
         shape (rows, nq) [m/rad]; link-pair flags, shape (rows,) bool), or None on an overlap.
     """
-    c = compiled
-    out = _rows(
-        q,
-        c.parents,
-        c.joint_rot,
-        c.joint_p,
-        c.axes,
-        c.q_index,
-        c.ee_joint,
-        c.ee_p,
-        c.ee_rot,
-        c.vertices,
-        c.starts,
-        c.neighbours,
-        c.offsets,
-        c.hints,
-        c.simplices,
-        c.radii,
-        c.shape_joint,
-        c.shape_rot,
-        c.shape_p,
-        c.capsule_a,
-        c.capsule_b,
-        c.capsule_r,
-        c.pairs,
-        c.cells,
-        influence,
-        q.size,
-    )
+    out = _rows(q, compiled.inputs(), compiled.cells, influence, q.size)
     return None if out[6] else out[:6]
 
 
 @jit()
-def _lever(oR, op, axes, parents, q_index, joint, point, normal, sign, row):
+def _lever(oR, op, chain, joint, point, normal, sign, row):
     """row += sign · n·(∂point/∂q): for each revolute joint k above `joint`, the world axis
     a_k and origin o_k give n·(a_k × (p − o_k)) = a_k · ((p − o_k) × n)."""
+    axes, q_index, parents = chain.axes, chain.q_index, chain.parents
     k = joint
     while k != 0:
         rx, ry, rz = point[0] - op[k, 0], point[1] - op[k, 1], point[2] - op[k, 2]
@@ -100,8 +73,9 @@ def _lever(oR, op, axes, parents, q_index, joint, point, normal, sign, row):
 
 
 @jit()
-def _jacobian(oR, op, axes, parents, q_index, joint, point, nq):
+def _jacobian(oR, op, chain, joint, point, nq):
     """The 6 × nq world-axes Jacobian of a point moving with `joint`: (a_k × (p − o_k); a_k)."""
+    axes, q_index, parents = chain.axes, chain.q_index, chain.parents
     J = np.zeros((6, nq))
     k = joint
     while k != 0:
@@ -117,42 +91,14 @@ def _jacobian(oR, op, axes, parents, q_index, joint, point, nq):
 
 
 @jit()
-def _rows(
-    q,
-    parents,
-    joint_rot,
-    joint_p,
-    axes,
-    q_index,
-    ee_joint,
-    ee_p,
-    ee_rot,
-    vertices,
-    starts,
-    neighbours,
-    offsets,
-    hints,
-    simplices,
-    radii,
-    shape_joint,
-    shape_rot,
-    shape_p,
-    capsule_a,
-    capsule_b,
-    capsule_r,
-    pairs,
-    cells,
-    influence,
-    nq,
-):
+def _rows(q, inputs, cells, influence, nq):
     """clearance_rows in one compiled call; the last item flags an overlap."""
-    oR, op = _joint_poses(q, parents, joint_rot, joint_p, axes, q_index)
-    ee, ee_R = _ee_pose(oR, op, ee_joint, ee_p, ee_rot)
-    J = _jacobian(oR, op, axes, parents, q_index, ee_joint, ee, nq)
-    world_R, world_p, ends = _shape_poses(
-        oR, op, shape_joint, shape_rot, shape_p, capsule_a, capsule_b, pairs
-    )
-    lower = _capsule_gaps(ends, capsule_r, pairs)
+    chain, shapes, pairs = inputs.chain, inputs.shapes, inputs.pairs
+    oR, op = _joint_poses(q, chain)
+    ee, ee_R = _ee_pose(oR, op, chain)
+    J = _jacobian(oR, op, chain, chain.ee_joint, ee, nq)
+    world_R, world_p, ends = _shape_poses(oR, op, shapes, pairs)
+    lower = _capsule_gaps(ends, shapes.capsule_r, pairs)
     best = np.full(cells, np.inf)
     on_a = np.zeros((cells, 3))
     on_b = np.zeros((cells, 3))
@@ -167,19 +113,19 @@ def _rows(
             continue  # the capsules already rule it out
         a, b = pairs[k, 0], pairs[k, 1]
         d = gjk_witnesses(
-            vertices,
-            neighbours,
-            offsets,
-            hints,
+            shapes.vertices,
+            shapes.neighbours,
+            shapes.offsets,
+            inputs.scratch.hints,
             a,
             world_R[a],
             world_p[a],
-            radii[a],
+            shapes.radii[a],
             b,
             world_R[b],
             world_p[b],
-            radii[b],
-            simplices[pairs[k, 2]],
+            shapes.radii[b],
+            inputs.scratch.simplices[pairs[k, 2]],
             point_a,
             point_b,
         )
@@ -204,21 +150,8 @@ def _rows(
         for i in range(3):
             normal[i] = gap[i] / length
         row = gradient[count]
-        _lever(
-            oR, op, axes, parents, q_index, shape_joint[shape_a[cell]], on_a[cell], normal, 1.0, row
-        )
-        _lever(
-            oR,
-            op,
-            axes,
-            parents,
-            q_index,
-            shape_joint[shape_b[cell]],
-            on_b[cell],
-            normal,
-            -1.0,
-            row,
-        )
+        _lever(oR, op, chain, shapes.joint[shape_a[cell]], on_a[cell], normal, 1.0, row)
+        _lever(oR, op, chain, shapes.joint[shape_b[cell]], on_b[cell], normal, -1.0, row)
         moving = False
         for i in range(nq):
             if row[i] != 0.0:

@@ -11,6 +11,7 @@ the rig sends it (an emulated rig); a real rig has only its sensor's (i_meas).
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -33,18 +34,48 @@ from articula.rigs.programs import Program, Shape
 from articula.rigs.protocol import Info, Kind
 from articula.rigs.recorder import Recorder
 from articula.rigs.run import run_program
+from articula.validation import load_toml, parse_model
 
 DEVICE_CHANNELS = tuple(c.name for c in MEASURED + EMULATED)  # the emulated device's
 
 
 def channels(info: Info) -> tuple[str, ...]:
-    """The recorder's columns: what the rig sends (firmware: the measured channels only)."""
+    """The recorder's columns: what the rig sends (firmware: the measured channels only).
+
+    Args:
+        info: The rig's INFO.
+
+    Returns:
+        Its channels' names.
+    """
     return tuple(c.name for c in info.channels)
+
+
+def plant_config(path: Path | None) -> CurrentControlConfig:
+    """The motor.current config whose plant an emulated motor rig has.
+
+    Args:
+        path: A motor.current config file (its `experiment` key is optional); None: chapter
+            4's defaults.
+
+    Returns:
+        The config (ConfigError naming the file and key where it does not read).
+    """
+    data = {} if path is None else load_toml(path)
+    data.pop("experiment", None)
+    return parse_model(CurrentControlConfig, data, str(path or "defaults"))
 
 
 def emulated_motor(config: CurrentControlConfig) -> MotorDevice:
     """A motor rig whose plant is `config`'s (motor, rig, dt, PWM, sensor, encoder); the
-    gains, reference, duration and seed are what the host sends."""
+    gains, reference, duration and seed are what the host sends.
+
+    Args:
+        config: The plant's config (its gains, reference and duration are not used).
+
+    Returns:
+        The emulated device, its compiled loop loaded.
+    """
 
     def plant(gains: MotorGains, reference: Program, duration: float, seed: int) -> np.ndarray:
         current, amplitude, frequency, speed = reference.values
@@ -67,6 +98,8 @@ def emulated_motor(config: CurrentControlConfig) -> MotorDevice:
         channels, _ = simulate_batch(run, trials=1)
         return np.column_stack([channels[name][0] for name in DEVICE_CHANNELS])
 
+    # The loop's compiled code loads (or compiles) now, not while a host waits on a run.
+    simulate_batch(config.model_copy(update={"duration": 4 * config.dt, "settle": 0.0}), 1)
     return MotorDevice(plant, config.dt)
 
 
@@ -85,7 +118,14 @@ FIRMWARE_BUILD = {
 def firmware_motor(config: CurrentControlConfig) -> MotorPins:
     """The plant behind the motor firmware's pins: `config`'s rig and motor, with the
     loop period, PWM, sensor and encoder the firmware is built for (ConfigError otherwise);
-    the firmware computes its feed-forward (4.13) with Table 4.2's R and K."""
+    the firmware computes its feed-forward (4.13) with Table 4.2's R and K.
+
+    Args:
+        config: The plant's config.
+
+    Returns:
+        The pins' plant for the firmware harness.
+    """
     for name, built in FIRMWARE_BUILD.items():
         value = config
         for part in name.split("."):
@@ -104,7 +144,16 @@ def firmware_motor(config: CurrentControlConfig) -> MotorPins:
 
 
 def run_on_rig(config: CurrentControlConfig, link: Link, recorder: Recorder) -> dict[str, float]:
-    """One run of `config` on the rig behind `link`; chapter 4's metrics of its trace."""
+    """One run of `config` on the rig behind `link`.
+
+    Args:
+        config: The motor.current config; its gains and reference are sent to the rig.
+        link: The line to a motor rig.
+        recorder: Takes every sample as it arrives.
+
+    Returns:
+        Chapter 4's metrics of the trace (NaN where the rig sends no true current).
+    """
     c = config
     gains = MotorGains(
         c.controller.kp,
@@ -130,7 +179,17 @@ def trace_metrics(
     config: CurrentControlConfig, t: np.ndarray, trace: dict[str, np.ndarray]
 ) -> dict[str, Any]:
     """Chapter 4's metrics (experiments/motor.py) from a recorded trace: the running sums
-    of loops.motor_current computed from its columns, then metrics_from_sums."""
+    of loops.motor_current computed from its columns, then metrics_from_sums.
+
+    Args:
+        config: The run's motor.current config.
+        t: Sample times [s], shape (n,).
+        trace: Column name -> values, shape (n,): i_ref, i_fb, v1 and i (or i_meas), omega
+            (or omega_meas).
+
+    Returns:
+        The metrics, each an array of one value.
+    """
     window = metric_window(config)
     s = window.settle_index
     i = trace.get("i", trace["i_meas"])

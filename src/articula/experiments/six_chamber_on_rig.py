@@ -23,12 +23,28 @@ CHANNELS = ("bend_x_deg", "bend_y_deg")  # the recorder's columns
 
 
 def channels(info: Info) -> tuple[str, ...]:
-    """The recorder's columns for the rig that `info` describes."""
+    """The recorder's columns for the rig that `info` describes.
+
+    Args:
+        info: The rig's INFO.
+
+    Returns:
+        The sensor's two bend angles.
+    """
     return CHANNELS
 
 
 def run_on_rig(config: DeactuationConfig, link: Link, recorder: Recorder) -> dict[str, float]:
-    """One actuate-hold-deactuate run of `config` on the rig behind `link`; the metrics."""
+    """One actuate-hold-deactuate run of `config` on the rig behind `link`.
+
+    Args:
+        config: The softarm.damping config; its actuation and damping are sent to the rig.
+        link: The line to a six-chamber rig.
+        recorder: Takes every sample as it arrives.
+
+    Returns:
+        Peak [°], overshoot [%], settling [s] and the angle at deactuation [°].
+    """
     actuation = Program(Shape.ACTUATION, (config.side_deg, config.gauge, config.hold))
     link.command(Kind.SET_REFERENCE, actuation.encode())
     link.command(Kind.SET_DAMPING, encode_damping(config.damping))

@@ -1,0 +1,147 @@
+"""Chapter 2's tuners on a PneuNet rig over serial (`articula rig tune`): the book's
+coordinate descent (Algorithm 1), scripted manual tuning and Ziegler-Nichols, each probe one
+experiment on the rig.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from articula.book.ch2.study import ZN_LADDER, ZN_SEED_OFFSET
+from articula.book.ch2.tuning import TuningConfig, auto_run, auto_seed, manual_seed
+from articula.book.study import packaged
+from articula.errors import ConfigError
+from articula.rigs.link import Link
+from articula.rigs.pneunet import PneuNetRig
+from articula.rigs.programs import steps
+from articula.rigs.protocol import RigKind
+from articula.runs.folders import TUNING, check_out, claimed
+from articula.runs.records import atomic_write
+from articula.tuning.manual import (
+    GainExperiment,
+    ManualSettings,
+    manual_tuning,
+    ultimate_gain,
+    ziegler_nichols,
+)
+from articula.tuning.response import Response
+from articula.validation import load_toml, parse_model
+
+TUNERS = ("descent", "manual", "ziegler-nichols")
+
+
+def tune_on_rig(
+    tuning: TuningConfig,
+    link: Link,
+    method: str,
+    levels: tuple[float, ...],
+    index: int = 0,
+    on_experiment: Callable[[], None] | None = None,
+) -> dict[str, Any]:
+    """Chapter 2's tuners, unchanged, with the rig behind `link` as their experiment: the
+    coordinate descent (Algorithm 1) on steps through `levels`, the scripted manual procedure
+    or Ziegler-Nichols' ultimate gain on a step to levels[0] [°]; the noise seeds are the
+    in-process runs' (an emulated rig then gives their numbers). Returns the result as JSON."""
+
+    def rig(program_levels: tuple[float, ...], hold: float, seed: int) -> GainExperiment:
+        on_rig = PneuNetRig(link, steps(program_levels, hold), len(program_levels) * hold, seed)
+
+        def experiment(k: np.ndarray) -> Response:
+            if on_experiment is not None:
+                on_experiment()
+            return on_rig(k)
+
+        return experiment
+
+    m, level = tuning.manual, levels[0]
+    if method == "descent":
+        run = auto_run(
+            tuning, levels, index, rig(levels, tuning.auto.hold, auto_seed(tuning, index))
+        ).result
+        return {
+            "method": method,
+            "levels_deg": list(levels),
+            "gains": run.k.tolist(),
+            "cost": run.cost,
+            "experiments": run.evaluations,
+            "sweeps": len(run.history) - 1,
+        }
+    if method == "manual":
+        experiment = rig((level,), m.hold, manual_seed(tuning, level))
+        found = manual_tuning(experiment, ManualSettings(band=m.band, tolerance=m.tolerance))
+        return {
+            "method": method,
+            "levels_deg": [level],
+            "gains": found.gains.tolist(),
+            "experiments": len(found.trials),
+            "within_tolerance": found.within_tolerance,
+        }
+    if method != "ziegler-nichols":
+        raise ConfigError("--method", f"unknown tuner {method!r}; choose one of {TUNERS}")
+    ku, tu, trials = ultimate_gain(
+        rig((level,), m.hold, m.seed + ZN_SEED_OFFSET), ZN_LADDER, m.band
+    )
+    return {
+        "method": method,
+        "levels_deg": [level],
+        "ku": ku,
+        "tu_s": tu,
+        "gains": ziegler_nichols(ku, tu, "PID").tolist(),
+        "gains_pi": ziegler_nichols(ku, tu, "PI").tolist(),
+        "experiments": len(trials),
+    }
+
+
+def parse_levels(levels: str) -> tuple[float, ...]:
+    """Reference levels [°] from a comma-separated list (ConfigError naming --levels)."""
+    try:
+        return tuple(float(v) for v in levels.split(","))
+    except ValueError:
+        raise ConfigError(
+            "--levels", f"comma-separated angles in degrees (got {levels!r})"
+        ) from None
+
+
+def tune_into(
+    out_dir: Path,
+    port: str,
+    method: str,
+    config: Path | None,
+    levels: tuple[float, ...],
+    index: int,
+    force: bool,
+    on_experiment: Callable[[], None] | None = None,
+) -> dict[str, Any]:
+    """Tune the PneuNet rig on `port` and write the result to `out_dir`/tuning.json.
+
+    Args:
+        out_dir: The run folder (refused as `articula run` refuses one, unless `force`).
+        port: The rig's serial port.
+        method: One of TUNERS.
+        config: A chapter-2 tuning config; None for the book's quick one.
+        levels: Reference levels [°] (manual and Ziegler-Nichols: a step to the first).
+        index: Which run of the config's seeds.
+        force: Overwrite a run folder that holds other files.
+        on_experiment: Called before each experiment on the rig.
+
+    Returns:
+        The result, as written to tuning.json, with the link's statistics under "link".
+    """
+    if method not in TUNERS:
+        raise ConfigError(
+            "--method", f"unknown tuner {method!r}; choose one of {', '.join(TUNERS)}"
+        )
+    data = load_toml(config or packaged("ch2", "tuning_quick.toml"))
+    tuning = parse_model(TuningConfig, data, str(config or "tuning_quick.toml"))
+    check_out(out_dir, "run", force)
+    with Link(port, RigKind.PNEUNET) as link, claimed(out_dir, "run", force):
+        result = tune_on_rig(tuning, link, method, levels, index, on_experiment)
+        result["link"] = dataclasses.asdict(link.stats)
+        atomic_write(out_dir / TUNING, json.dumps(result, indent=2).encode())
+    return result
