@@ -75,7 +75,7 @@ def test_a_point_closer_to_itself_than_the_margin_is_outside_omega_on_every_path
         kept, g = objective.project_and_value(q, clear, 7.0, target, 0.0)
         assert np.array_equal(kept, clear) and g == 7.0
     objective = Objective(scene, 0.0, 1.0, 0.0)
-    kept, g, _ = baornn_kernel._project_and_value(
-        q, clear, 7.0, 0.5, objective.reference(target), objective.problem()
-    )
+    reference = baornn_kernel.Reference(*objective.reference(target))
+    problem = baornn_kernel.Problem(*objective.problem())
+    kept, g, _ = baornn_kernel._project_and_value(q, clear, 7.0, 0.5, reference, problem)
     assert np.array_equal(kept, clear) and g == 7.0

@@ -13,7 +13,6 @@ import numpy as np
 
 from articula.numba_cache import jit
 from articula.planning.task import orientation_error
-from articula.scene.compiled_bundles import ClearanceInputs
 from articula.scene.compiled_clearance import _evaluate
 
 # Ω's floor on self clearance [m] (docs/deviations.md, self-collision). The compiled GJK and
@@ -25,7 +24,7 @@ SELF_CONTACT_MARGIN = 1e-4
 
 
 class Reference(NamedTuple):
-    """A period's target as the kernels take it (Objective.reference).
+    """A period's target as the kernels name it (Objective.reference packs it).
 
     Attributes:
         position: x_r, shape (3,) [m].
@@ -45,7 +44,7 @@ class Reference(NamedTuple):
 
 
 class Problem(NamedTuple):
-    """g's weights and Ω as the kernels take them (Objective.problem).
+    """g's weights and Ω as the kernels name them (Objective.problem packs them).
 
     Attributes:
         lambda_weight: penalty weight Λ of Eq. (1.7) [m^(1+β)].
@@ -55,7 +54,7 @@ class Problem(NamedTuple):
         lower: lower bound of the projection box, shape (nq,) [rad].
         upper: upper bound of the projection box, shape (nq,) [rad].
         stop: the braking check (objective.Stop: q_base, change, sweep).
-        clearance: the compiled scene with the pairs that count.
+        clearance: the compiled scene with the pairs that count (ClearanceInputs, packed).
         static_min: smallest distance of the pairs that never move, per kind, shape (2,) [m].
     """
 
@@ -66,7 +65,7 @@ class Problem(NamedTuple):
     lower: np.ndarray
     upper: np.ndarray
     stop: tuple
-    clearance: ClearanceInputs
+    clearance: tuple
     static_min: np.ndarray
 
 
@@ -88,7 +87,7 @@ def outside_omega(d: float, d_self: float, d_min: float, self_d_min: float) -> b
     return d <= d_min or d_self <= max(self_d_min, SELF_CONTACT_MARGIN)
 
 
-@jit()
+@jit(inline="always")
 def _task_error(ee, ee_R, reference):
     """||x_r − f(θ)|| (Eq. 1.5), plus weight · orientation error for a pose or axis task."""
     x_ref = reference.position
@@ -116,7 +115,8 @@ def stoppable(clipped, d, d_self, d_min, self_d_min, stop, clearance, static_min
         stop: the braking check (objective.Stop: q_base, the period's start; change, each
             joint's largest change of motion per period, empty: no acceleration limit; sweep,
             how far a shape point moves at most per unit of each joint's motion).
-        clearance: the compiled scene with the pairs that count.
+        clearance: the compiled scene with the pairs that count (ClearanceInputs,
+            packed).
         static_min: smallest distance of the pairs that never move, per kind, shape (2,) [m].
 
     Returns:
@@ -139,7 +139,7 @@ def stoppable(clipped, d, d_self, d_min, self_d_min, stop, clearance, static_min
     return not outside_omega(d_stop, d_self_stop, d_min, self_d_min)
 
 
-@jit()
+@jit(inline="always")
 def _braking_clear(q, d, d_self, problem):
     """stoppable with the problem's Ω and braking check."""
     p = problem
@@ -177,15 +177,16 @@ def iterations(q, g, reference, directions, c1, c2, problem):
     Args:
         q: joint angles, shape (nq,) [rad].
         g: objective g(q) there.
-        reference: the period's target (Reference).
+        reference: the period's target (Reference, packed: Objective.reference).
         directions: raw Gaussian draws, one row per iteration, normalised here, shape (k, nq).
         c1: antenna length constant of Eq. (1.23) [rad/√m].
         c2: step constant of Eq. (1.24).
-        problem: g's weights and Ω (Problem).
+        problem: g's weights and Ω (Problem, packed: Objective.problem).
 
     Returns:
         The accepted joint angles, shape (nq,) [rad], and their objective g.
     """
+    reference, problem = Reference(*reference), Problem(*problem)
     for k in range(directions.shape[0]):
         b = directions[k] / math.sqrt(directions[k] @ directions[k])
         lam = c1 * math.sqrt(g) if math.isfinite(g) else c1  # Eq. (1.23)
@@ -257,17 +258,18 @@ def improved_period(q, g_known, warm_motion, reference, draws, c1, c2, short, pr
         q: joint angles at the start of the period, shape (nq,) [rad].
         g_known: the caller's g(q), or NaN to compute it here.
         warm_motion: last period's joint motion, shape (nq,) [rad]; empty for no warm start.
-        reference: the period's target (Reference).
+        reference: the period's target (Reference, packed: Objective.reference).
         draws: Gaussian draws, one matrix per iteration, shape (k, nq, pairs).
         c1: antenna length constant, λ_k = c1·√e_k [rad/√m].
         c2: step constant of Eq. (1.24).
         short: relative length of every second antenna pair.
-        problem: g's weights and Ω (Problem).
+        problem: g's weights and Ω (Problem, packed: Objective.problem).
 
     Returns:
         The accepted joint angles, shape (nq,) [rad], their objective g, and the number of
         objective evaluations.
     """
+    reference, problem = Reference(*reference), Problem(*problem)
     d, d_self, ee, ee_R = _evaluate(q, problem.clearance, problem.static_min)
     e = _task_error(ee, ee_R, reference)
     g = _penalised(e, d, problem.lambda_weight, problem.beta) if math.isnan(g_known) else g_known

@@ -8,8 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from articula.planning.evaluation import evaluation_for
 from articula.scene import compiled_rows
-from articula.scene.compiled_clearance import CompiledClearance
 from articula.scene.scene import Scene
 
 
@@ -52,11 +52,17 @@ class RowSource:
     Args:
         scene: the robot, its obstacles and its checked link pairs.
         use_compiled: try the compiled evaluation (False: always Pinocchio and coal).
+
+    Attributes:
+        scene: the scene.
+        evaluation: its clearance and end-effector measurement (planning/evaluation.py).
+        compiled: the evaluation's compiled arrays, or None.
     """
 
     def __init__(self, scene: Scene, use_compiled: bool = True) -> None:
         self.scene = scene
-        self.compiled = CompiledClearance.build(scene) if use_compiled else None
+        self.evaluation = evaluation_for(scene, use_compiled)
+        self.compiled = self.evaluation.compiled
 
     def __call__(
         self, q: np.ndarray, t: float, influence: float

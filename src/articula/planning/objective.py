@@ -84,7 +84,7 @@ class Objective:
         cylinders, GJK metric) and `use_compiled`; None: the Scene (Pinocchio + coal)."""
         return self.evaluation.compiled
 
-    def problem(self, box: Box | None = None, t: float = 0.0, stop: Stop = NO_STOP) -> Problem:
+    def problem(self, box: Box | None = None, t: float = 0.0, stop: Stop = NO_STOP) -> tuple:
         """g's weights and Ω as planning.baornn_kernel takes them (requires `compiled`).
 
         Args:
@@ -93,8 +93,8 @@ class Objective:
             stop: the period's braking check; NO_STOP: none.
 
         Returns:
-            The problem, its clearance holding only the pairs that count (far ones pruned
-            from a period's box).
+            The Problem packed (compiled_bundles.packed), its clearance holding only the
+            pairs that count (far ones pruned from a period's box).
         """
         robot, c = self.scene.robot, self.compiled
         if c is None:
@@ -105,8 +105,9 @@ class Objective:
             # A period's reach, and where braking from it ends: far obstacles drop out.
             pairs = c.near_pairs(pairs, _braking_box(box, stop))
         lower, upper = box or (robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
-        return Problem(self.lambda_weight, self.beta, self.d_min, self.self_d_min, lower, upper,
-                       stop, c.inputs(pairs), static_min)  # fmt: skip
+        # Packed by hand: the clearance comes packed, and the rest are arrays and numbers.
+        return tuple(Problem(self.lambda_weight, self.beta, self.d_min, self.self_d_min, lower,
+                             upper, tuple(stop), c.inputs(pairs), static_min))  # fmt: skip
 
     @cached_property
     def sweep(self) -> np.ndarray:
@@ -125,19 +126,19 @@ class Objective:
         then no link-obstacle distance is computed at all."""
         return bool(self.scene.obstacles) and (self.lambda_weight > 0 or self.d_min > 0)
 
-    def reference(self, target: Target) -> Reference:
+    def reference(self, target: Target) -> tuple:
         """A period's target as planning.baornn_kernel takes it.
 
         Args:
             target: the period's target.
 
         Returns:
-            Its position, the task's code, weight and tool axis, and the reference rotation
-            and axis.
+            The Reference packed: its position, the task's code, weight and tool axis, and
+            the reference rotation and axis.
         """
         R_ref, axis_ref = target_arrays(self.task, target)
         t = self.task
-        return Reference(target.position, t.code, t.weight, t.tool_axis, R_ref, axis_ref)
+        return tuple(Reference(target.position, t.code, t.weight, t.tool_axis, R_ref, axis_ref))
 
     def value(self, q: np.ndarray, target: Target | np.ndarray, t: float = 0.0) -> float:
         """Objective g at configuration q [rad] for the target (or a position [m]).

@@ -178,9 +178,5 @@ class ResolvedRate:
 
     def _clearances(self, q: np.ndarray, t: float) -> np.ndarray:
         """(link-obstacle, self) clearance at q [m], compiled where the scene allows it."""
-        compiled = self._rows.compiled
-        if compiled is not None:
-            compiled.at(t)
-            d, d_self, _, _ = compiled.evaluate(q)
-            return np.array([d, d_self])
-        return np.array(self.scene.clearances(q, t))
+        d, d_self, _, _ = self._rows.evaluation.measure(q, t, True, True)
+        return np.array([d, d_self])

@@ -8,6 +8,7 @@ import math
 import numpy as np
 
 from articula.numba_cache import jit
+from articula.scene.compiled_bundles import named_inputs
 from articula.scene.compiled_poses import _apply, _capsule_gaps, _joint_poses, _shape_poses
 
 
@@ -31,8 +32,10 @@ def _pair_bounds(q, chain, shapes, pairs):
 
 
 @jit()
-def _near_pairs(lower, upper, reach, static_min, chain, shapes, pairs):
+def _near_pairs(lower, upper, reach, static_min, packed_inputs):
     """CompiledClearance.near_pairs in one compiled call (it runs once per control period)."""
+    inputs = named_inputs(packed_inputs)
+    chain, shapes, pairs = inputs.chain, inputs.shapes, inputs.pairs
     centre = (lower + upper) / 2.0
     delta = reach * np.sum(upper - lower) / 2.0
     below, above = _pair_bounds(centre, chain, shapes, pairs)

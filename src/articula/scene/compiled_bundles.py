@@ -3,8 +3,18 @@ the search's scratch, each a NamedTuple of arrays (numba passes one as a typed r
 kernel names `chain.parents` instead of taking 24 arrays in a row).
 
 `Chain` never changes after it is built; `Shapes` changes only where a moving obstacle is put
-at a new pose (`shape_rot`, `shape_p`, in place); `Scratch` is the evaluations' memory and
+at a new pose (`rot`, `p`, in place); `Scratch` is the evaluations' memory and
 changes at every call.
+
+A bundle crosses from Python into a kernel as plain nested tuples (`packed`), and the kernel
+names it again at its top (`named_inputs`, `Problem(*problem)`): numba's dispatcher types a
+NamedTuple argument more than twice as slowly as a plain tuple of the same arrays
+(benchmarks/bundle_dispatch.py on the iiwa14 scene: 3.6 µs against 1.5 µs per call, the
+difference a quarter of an evaluation), while naming it inside a kernel costs nothing.
+Calls between kernels pass the named form; a helper that takes a bundle and runs at every
+evaluation is inlined (`jit(inline="always")`), and one that runs per pair takes only the
+arrays it reads, since a call that is not inlined counts references twice for every array of
+its arguments (together about a tenth of a BAORNN iteration, benchmarks/baornn.py).
 """
 
 from __future__ import annotations
@@ -12,6 +22,8 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+
+from articula.numba_cache import jit
 
 
 class Chain(NamedTuple):
@@ -117,3 +129,30 @@ class ClearanceInputs(NamedTuple):
     shapes: Shapes
     scratch: Scratch
     pairs: np.ndarray
+
+
+def packed(bundle: tuple) -> tuple:
+    """A bundle as plain nested tuples, the form kernels take from Python (the same arrays,
+    not copies: a kernel's writes reach the bundle's arrays).
+
+    Args:
+        bundle: a NamedTuple of arrays, numbers and bundles.
+
+    Returns:
+        The same fields in order, nested bundles packed likewise.
+    """
+    return tuple(packed(field) if isinstance(field, tuple) else field for field in bundle)
+
+
+@jit(inline="always")
+def named_inputs(inputs):
+    """ClearanceInputs from its packed form (inlined into each kernel that takes it).
+
+    Args:
+        inputs: the packed form (CompiledClearance.inputs): chain, shapes, scratch, pairs.
+
+    Returns:
+        The same arrays as a ClearanceInputs.
+    """
+    chain, shapes, scratch, pairs = inputs
+    return ClearanceInputs(Chain(*chain), Shapes(*shapes), Scratch(*scratch), pairs)

@@ -20,7 +20,7 @@ import pinocchio as pin
 from articula.numba_cache import jit
 from articula.scene._compiled_arrays import _capsule_ends, _core, _edges, _pair_rows, _reach
 from articula.scene._compiled_pruning import _near_pairs
-from articula.scene.compiled_bundles import Chain, ClearanceInputs, Scratch, Shapes
+from articula.scene.compiled_bundles import Chain, Scratch, Shapes, named_inputs, packed
 from articula.scene.compiled_poses import (
     _ee_pose,
     _joint_poses,
@@ -74,6 +74,7 @@ class CompiledClearance:
         self.chain, self.shapes, self.pairs, self.cells = chain, shapes, pairs, cells
         self.reach, self.moving_parts = reach, moving_parts
         self.scratch = Scratch.fresh(shapes.starts, rows)
+        self._packed = packed((chain, shapes, self.scratch))  # the same arrays, built once
         self.static_min = np.full(2, np.inf)
         self._selected: dict = {}  # select's answers, by kinds
 
@@ -177,7 +178,7 @@ class CompiledClearance:
             t: time [s].
         """
         for shape, obstacle in self.moving_parts:
-            _place(shape, obstacle.pose_at(t), self.shapes, self.scratch.memory, self.pairs)
+            _place(shape, obstacle.pose_at(t), self.inputs())
 
     def evaluate(
         self, q: np.ndarray, obstacles: bool = True, self_pairs: bool = True
@@ -232,26 +233,28 @@ class CompiledClearance:
         Returns:
             The rows kept, shape (k', 5).
         """
-        return _near_pairs(box[0], box[1], self.reach, self.static_min[OBSTACLE], self.chain,
-                           self.shapes, pairs)  # fmt: skip
+        return _near_pairs(box[0], box[1], self.reach, self.static_min[OBSTACLE],
+                           self.inputs(pairs))  # fmt: skip
 
-    def inputs(self, pairs: np.ndarray | None = None) -> ClearanceInputs:
+    def inputs(self, pairs: np.ndarray | None = None) -> tuple:
         """What the compiled evaluation reads, after q and before static_min.
 
         Args:
             pairs: the pair rows to evaluate, shape (k, 5); None for all of `pairs`.
 
         Returns:
-            The chain, shapes, scratch and pair rows.
+            ClearanceInputs (chain, shapes, scratch, pair rows) packed, as kernels take it
+            from Python (compiled_bundles.packed).
         """
-        pairs = self.pairs if pairs is None else pairs
-        return ClearanceInputs(self.chain, self.shapes, self.scratch, pairs)
+        return (*self._packed, self.pairs if pairs is None else pairs)
 
 
 @jit()
-def _place(shape, T, shapes, memory, pairs):
+def _place(shape, T, packed_inputs):
     """Put an obstacle's shape at pose T (4×4, world), lowering the remembered bound of each
     of its pairs by how far it moved."""
+    inputs = named_inputs(packed_inputs)
+    shapes, memory, pairs = inputs.shapes, inputs.scratch.memory, inputs.pairs
     R, p = np.ascontiguousarray(T[:3, :3]), np.ascontiguousarray(T[:3, 3])
     before = np.concatenate((shapes.rot[shape].ravel(), shapes.p[shape])).reshape(1, 12)
     moved = _moved(before, 0, 0, R.reshape(1, 3, 3), p.reshape(1, 3), 0, shapes.extents[shape])
@@ -264,7 +267,7 @@ def _place(shape, T, shapes, memory, pairs):
 
 
 @jit()
-def _evaluate(q, inputs, static_min):
+def _evaluate(q, packed_inputs, static_min):
     """(obstacle clearance, self clearance, end-effector position, end-effector rotation):
     forward kinematics, shape poses, lower bounds, then exact GJK in order of bound, skipping
     a pair whose bound is not below the best distance of its kind (the broad phase of Scene).
@@ -273,6 +276,7 @@ def _evaluate(q, inputs, static_min):
     it out) less how far each shape has moved since: a search evaluates nearby
     configurations, so a far pair is measured once, not at every evaluation. Its capsules'
     gap is taken only when that is not enough, and remembered when it rules the pair out."""
+    inputs = named_inputs(packed_inputs)
     chain, shapes, pairs = inputs.chain, inputs.shapes, inputs.pairs
     memory, simplices = inputs.scratch.memory, inputs.scratch.simplices
     oR, op = _joint_poses(q, chain)
@@ -282,8 +286,9 @@ def _evaluate(q, inputs, static_min):
     lower = np.empty(npairs)
     has_obstacle = has_self = False  # a kind without pairs here cannot improve
     for k in range(npairs):
+        a, b = pairs[k, 0], pairs[k, 1]
         lower[k] = _remembered_bound(
-            memory, pairs[k, 2], pairs[k, 0], pairs[k, 1], world_R, world_p, shapes
+            memory, pairs[k, 2], a, b, world_R, world_p, shapes.extents, shapes.joint
         )
         if pairs[k, 3] == 1:
             has_self = True
@@ -308,8 +313,8 @@ def _evaluate(q, inputs, static_min):
             continue
         a, b = pairs[k, 0], pairs[k, 1]
         row = memory[pairs[k, 2]]
-        _place_ends(a, world_R, world_p, shapes, ends)
-        _place_ends(b, world_R, world_p, shapes, ends)
+        _place_ends(a, world_R, world_p, shapes.capsule_a, shapes.capsule_b, ends)
+        _place_ends(b, world_R, world_p, shapes.capsule_a, shapes.capsule_b, ends)
         gap = _segment_distance(ends[a, 0], ends[a, 1], ends[b, 0], ends[b, 1])
         gap -= shapes.capsule_r[a] + shapes.capsule_r[b]
         if gap >= best:

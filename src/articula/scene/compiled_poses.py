@@ -96,7 +96,7 @@ def _segment_distance(p1: np.ndarray, q1: np.ndarray, p2: np.ndarray, q2: np.nda
     return np.sqrt(gx * gx + gy * gy + gz * gz)
 
 
-@jit()
+@jit(inline="always")
 def _joint_poses(q, chain):
     """World rotation and origin of every joint frame of `chain` (a Chain) at q (joint 0:
     the world)."""
@@ -114,7 +114,7 @@ def _joint_poses(q, chain):
     return oR, op
 
 
-@jit()
+@jit(inline="always")
 def _ee_pose(oR, op, chain):
     """The end effector's world position and rotation from its joint's pose and its
     placement (ee_rot, ee_p) in that joint's frame."""
@@ -126,7 +126,7 @@ def _ee_pose(oR, op, chain):
     return ee, ee_R
 
 
-@jit()
+@jit(inline="always")
 def _shape_poses(oR, op, shapes, pairs, ends_too=True):
     """World pose of every shape of `pairs` and (with ends_too; else unset, see _place_ends)
     the ends of its bounding capsule's segment (the other shapes' rows are left unset: a far
@@ -143,15 +143,16 @@ def _shape_poses(oR, op, shapes, pairs, ends_too=True):
                 j = shapes.joint[s]
                 _compose(oR[j], op[j], shapes.rot[s], shapes.p[s], world_R[s], world_p[s])
                 if ends_too:
-                    _place_ends(s, world_R, world_p, shapes, ends)
+                    _place_ends(s, world_R, world_p, shapes.capsule_a, shapes.capsule_b, ends)
     return world_R, world_p, ends
 
 
 @jit()
-def _place_ends(s, world_R, world_p, shapes, ends):
-    """ends[s] = the world ends of shape s's bounding capsule segment."""
-    _apply(world_R[s], world_p[s], shapes.capsule_a[s], ends[s, 0])
-    _apply(world_R[s], world_p[s], shapes.capsule_b[s], ends[s, 1])
+def _place_ends(s, world_R, world_p, capsule_a, capsule_b, ends):
+    """ends[s] = the world ends of shape s's bounding capsule segment (the two arrays, not
+    Shapes: this runs per pair, and each array passed costs two atomic reference counts)."""
+    _apply(world_R[s], world_p[s], capsule_a[s], ends[s, 0])
+    _apply(world_R[s], world_p[s], capsule_b[s], ends[s, 1])
 
 
 @jit()
@@ -182,16 +183,17 @@ def _moved(memory, row, at, world_R, world_p, s, extent):
 
 
 @jit()
-def _remembered_bound(memory, row, a, b, world_R, world_p, shapes):
+def _remembered_bound(memory, row, a, b, world_R, world_p, extents, joint):
     """The last lower bound of a pair (memory[row]: an exact distance or a capsule gap) less
     how far its shapes a and b moved since: a lower bound of its distance now (−inf before
     the first). A shape on joint 0 (an obstacle) has not moved: CompiledClearance.at charges
-    an obstacle's motion to its pairs' memory when it puts it at a new pose."""
+    an obstacle's motion to its pairs' memory when it puts it at a new pose. Shapes' extents
+    and joints, not Shapes: this runs per pair (see _place_ends)."""
     if memory[row, 0] == -np.inf:
         return -np.inf
-    bound = memory[row, 0] - _moved(memory, row, 1, world_R, world_p, a, shapes.extents[a])
-    if shapes.joint[b] != 0:
-        bound -= _moved(memory, row, 13, world_R, world_p, b, shapes.extents[b])
+    bound = memory[row, 0] - _moved(memory, row, 1, world_R, world_p, a, extents[a])
+    if joint[b] != 0:
+        bound -= _moved(memory, row, 13, world_R, world_p, b, extents[b])
     return bound
 
 

@@ -16,6 +16,7 @@ import math
 import numpy as np
 
 from articula.numba_cache import jit
+from articula.scene.compiled_bundles import named_inputs
 from articula.scene.compiled_clearance import CompiledClearance
 from articula.scene.compiled_poses import (
     _capsule_gaps,
@@ -91,8 +92,9 @@ def _jacobian(oR, op, chain, joint, point, nq):
 
 
 @jit()
-def _rows(q, inputs, cells, influence, nq):
+def _rows(q, packed_inputs, cells, influence, nq):
     """clearance_rows in one compiled call; the last item flags an overlap."""
+    inputs = named_inputs(packed_inputs)
     chain, shapes, pairs = inputs.chain, inputs.shapes, inputs.pairs
     oR, op = _joint_poses(q, chain)
     ee, ee_R = _ee_pose(oR, op, chain)
