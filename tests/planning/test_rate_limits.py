@@ -51,14 +51,22 @@ def test_a_joint_brakes_in_time_for_its_position_limit():
     assert m >= 0.1 - 0.02 - 1e-12  # and it can still brake within the acceleration limit
 
 
-@settings(max_examples=200, deadline=None)
-@given(st.lists(st.floats(0.0, 1.0), min_size=1, max_size=120), st.floats(0.2, 5.0))
-def test_any_motion_inside_each_box_keeps_every_limit(choices, acceleration):
+@settings(max_examples=300, deadline=None)
+@given(
+    st.lists(st.floats(0.0, 1.0), min_size=1, max_size=150),
+    st.floats(0.2, 5.0),
+    st.one_of(st.none(), st.floats(1.0, 8.0)),
+    st.floats(0.3, 0.99),
+)
+def test_any_motion_inside_each_box_keeps_every_limit(choices, acceleration, ramp_periods, start):
     """Whatever point of each period's box is taken, the motion never leaves the position
-    limits, never breaks the speed or acceleration limit, and the box is never empty."""
+    limits, never breaks the speed or acceleration limit or, with one (the acceleration reached
+    from zero in `ramp_periods` periods), the jerk limit, and the box is never empty, even
+    driving into a position limit or up to the speed limit."""
     speed, dt = 1.5, 0.05
-    rate = RateLimits(np.array([speed]), dt=dt, acceleration=acceleration)
-    q, last = np.array([0.9]), np.zeros(1)
+    jerk = None if ramp_periods is None else acceleration / (ramp_periods * dt)
+    rate = RateLimits(np.array([speed]), dt=dt, acceleration=acceleration, jerk=jerk)
+    q, last, last_change = np.array([start]), np.zeros(1), np.zeros(1)
     for u in choices:
         low, high = rate.box(q, LOWER, UPPER)
         assert not rate.strained
@@ -67,8 +75,26 @@ def test_any_motion_inside_each_box_keeps_every_limit(choices, acceleration):
         assert LOWER[0] - 1e-12 <= q_next[0] <= UPPER[0] + 1e-12
         assert abs(motion[0]) <= speed * dt * (1 + 1e-9)
         assert abs(motion[0] - last[0]) <= acceleration * dt**2 * (1 + 1e-9)
+        change = motion - last
+        if jerk is not None:
+            assert abs(change[0] - last_change[0]) <= jerk * dt**3 * (1 + 1e-6)
         rate.record(motion)
-        q, last = q_next, motion
+        q, last, last_change = q_next, motion, change
+
+
+@pytest.mark.parametrize("ramp_periods", [1.0, 4.0])
+def test_driving_into_a_position_limit_at_full_speed_stops_at_it(ramp_periods):
+    """Always taking the box's far end toward the upper limit: full speed, then a braking
+    whose deceleration ramps up in time, ending at the limit without a strained period."""
+    speed, dt, acceleration = 1.0, 0.01, 5.0
+    rate = RateLimits(np.array([speed]), dt, acceleration, acceleration / (ramp_periods * dt))
+    q = np.array([-1.0])
+    for _ in range(1000):
+        q_next = rate.box(q, LOWER, UPPER)[1]
+        assert not rate.strained and q_next[0] <= UPPER[0] + 1e-12
+        rate.record(q_next - q)
+        q = q_next
+    assert q[0] > UPPER[0] - 1e-3  # it got there
 
 
 def test_a_motion_beyond_the_limits_strains_the_box_to_its_nearest_point():
@@ -79,7 +105,11 @@ def test_a_motion_beyond_the_limits_strains_the_box_to_its_nearest_point():
     np.testing.assert_allclose([low[0], high[0]], [0.1, 0.1], rtol=1e-8)
 
 
-@pytest.mark.parametrize("fields", [{"velocity": [0.0, 1.0]}, {"dt": 0.0}, {"acceleration": -1.0}])
+@pytest.mark.parametrize(
+    "fields",
+    [{"velocity": [0.0, 1.0]}, {"dt": 0.0}, {"acceleration": -1.0}, {"jerk": 1.0},
+     {"acceleration": 1.0, "jerk": 0.0}],
+)  # fmt: skip
 def test_bad_limits_name_the_field(fields):
     with pytest.raises(ConfigError):
         RateLimits(**{"velocity": [1.0, 1.0], "dt": 0.1, **fields})

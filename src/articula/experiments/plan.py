@@ -14,13 +14,14 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
 import numpy as np
-from pydantic import model_validator
+from pydantic import Field, model_validator
 
 from articula.errors import ConfigError, InfeasibleError
 from articula.loops.online import OnlineController
+from articula.loops.servo import run_stream
 from articula.loops.tracking import trace_columns, track, tracking_metrics
 from articula.planning.approach import Approach, approach
 from articula.planning.config import (
@@ -34,15 +35,35 @@ from articula.planning.planner import Planner
 from articula.planning.reach import check_reach
 from articula.planning.target_path import TargetPath
 from articula.planning.task import Target
+from articula.runs.folders import SERVO
 from articula.runs.registry import Experiment, Progress, Result
 from articula.runs.runner import named_by_file
 from articula.scene.config import SceneSpec, build_scene
 from articula.scene.scene import Scene
-from articula.validation import Seed, fields_as, load_toml, parse_model
+from articula.validation import (
+    Seed,
+    StrictModel,
+    field_error,
+    fields_as,
+    load_toml,
+    parse_model,
+)
 
 NAME = "baornn.plan"
 # Library argument names -> where the user wrote them in a plan config.
 _CONFIG_PATHS = {"q0": "robot.q0", "dt": "planner.dt", "duration": "planner.duration"}
+
+
+class ServoSpec(StrictModel):
+    """[servo]: stream the plan's set-points to a joint servo (loops/servo.py) into
+    servo.parquet.
+
+    Attributes:
+        rate: the servo rate [Hz]: a whole number of ticks per control period (1000 for a
+            Franka, 500 for a UR's servoJ).
+    """
+
+    rate: Annotated[float, Field(gt=0, le=100_000, allow_inf_nan=False)]
 
 
 class PlanConfig(SceneSpec):
@@ -60,17 +81,38 @@ class PlanConfig(SceneSpec):
             rectangle, waypoints or CSV) and optionally the tool's orientation or axis.
         planner: the [planner] table: the method, its parameters, the control period and
             the run's duration.
+        servo: the [servo] table: the servo stream to write (planner.limits then defaults
+            to "velocity+acceleration+jerk", the only one it takes); None: none.
     """
 
     seed: Seed | None = None
     trajectory: TrajectorySpec
     planner: PlannerSpec = PlannerSpec()
+    servo: ServoSpec | None = None
 
     @model_validator(mode="after")
     def _one_seed(self) -> PlanConfig:
         seed = self.seed if self.seed is not None else self.planner.seed
         object.__setattr__(self, "seed", 0 if seed is None else seed)
         object.__setattr__(self, "planner", self.planner.model_copy(update={"seed": None}))
+        if self.servo is not None:
+            ticks = self.servo.rate * self.planner.dt
+            if round(ticks) < 1 or abs(ticks - round(ticks)) > 1e-6:
+                raise field_error(
+                    "servo.rate",
+                    f"servo.rate = {self.servo.rate:g} Hz is not a whole number of ticks per "
+                    f"planner.dt = {self.planner.dt:g} s; use a multiple of "
+                    f"{1 / self.planner.dt:g} Hz",
+                )
+            if "limits" not in self.planner.model_fields_set:  # a stream keeps the jerk limits
+                limits = {"limits": "velocity+acceleration+jerk"}
+                object.__setattr__(self, "planner", self.planner.model_copy(update=limits))
+            if self.planner.limits != "velocity+acceleration+jerk":
+                raise field_error(
+                    "planner.limits",
+                    f'planner.limits = "{self.planner.limits}": a servo stream needs set-points '
+                    'within the jerk limits; set planner.limits = "velocity+acceleration+jerk"',
+                )
         return self
 
 
@@ -213,15 +255,24 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
             f"= {p.orientation_tolerance} rad",
             "trajectory",
         )
-    return Result(metrics, trace_columns(run))
+    if config.servo is None:
+        return Result(metrics, trace_columns(run), details={"limits": _limits(plan.scene)})
+    stream, servo = run_stream(run, plan.scene.robot, config.servo.rate)
+    return Result(
+        metrics | servo,
+        trace_columns(run),
+        tables={SERVO: stream.columns()},
+        details={"limits": _limits(plan.scene)},
+    )
 
 
-def load_plan(path: Path) -> dict[str, Any]:
+def load_plan(path: Path, servo_rate: float | None = None) -> dict[str, Any]:
     """A scene file (or a plan folder's config.toml) as a `baornn.plan` config, its file paths
     made absolute.
 
     Args:
         path: the scene file or config.toml; its relative paths start at its folder.
+        servo_rate: a servo rate [Hz] that replaces the file's servo.rate; None: the file's.
 
     Returns:
         The config's tables as read from TOML, `experiment` set to "baornn.plan" when absent
@@ -237,7 +288,20 @@ def load_plan(path: Path) -> dict[str, Any]:
             f"{path}: experiment",
             f"plan runs {NAME} configs (got {name!r}); run this file with `articula run`",
         )
+    if servo_rate is not None:
+        data["servo"] = {**data.get("servo", {}), "rate": servo_rate}
     return absolute_paths(data, path.parent)
+
+
+def _limits(scene: Scene) -> dict[str, list[float | None]]:
+    """The robot's joint limits for the record: velocity, acceleration, jerk per joint (SI;
+    None for none)."""
+    robot = scene.robot
+    limits = (robot.velocity_limit, robot.acceleration_limit, robot.jerk_limit)
+    return {
+        name: [float(v) if np.isfinite(v) and v > 0 else None for v in values]
+        for name, values in zip(("velocity", "acceleration", "jerk"), limits, strict=True)
+    }
 
 
 def _with_method(spec: PlannerSpec, method: str, where: str) -> PlannerSpec:

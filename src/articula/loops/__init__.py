@@ -6,6 +6,7 @@ __all__ = [
     "motor_current_linear",
     "online",
     "pneunet_pid",
+    "servo",
     "six_chamber",
     "tracking",
 ]

@@ -152,8 +152,8 @@ def tracking_metrics(
     path started); clearance [m] and colliding steps over the whole run and once settled (the
     approach from q0 is the riskiest part), between the checked link pairs too
     (min_self_clearance, self_collisions; None without pairs); joint-limit violations; the
-    largest joint speed and acceleration over their limits (max_speed_ratio,
-    max_acceleration_ratio); the periods that could not keep every constraint
+    largest joint speed, acceleration and jerk over their limits (max_speed_ratio,
+    max_acceleration_ratio, max_jerk_ratio); the periods that could not keep every constraint
     (infeasible_steps); planner time per inner iteration (`iterations` in all) and per period
     [µs], both without the first period, and that period's time (first_period_ms).
     For a pose or axis task also rms_ and max_orientation_error [rad] after `settle`, and with
@@ -197,6 +197,7 @@ def tracking_metrics(
         "joint_limit_violations": float(np.sum(np.any(outside, axis=1))),
         "max_speed_ratio": max_speed_ratio(run, robot),
         "max_acceleration_ratio": max_acceleration_ratio(run, robot),
+        "max_jerk_ratio": max_jerk_ratio(run, robot),
         "infeasible_steps": float(run.infeasible),
         "approach_s": run.path_start,
         # The planner alone: BAORNN's inner iterations, or a baseline's periods; the first
@@ -240,12 +241,31 @@ def max_acceleration_ratio(run: PlanResult, robot: RobotModel) -> float:
         The largest acceleration ratio (above 1: a limit is broken); 0 for fewer than three
         samples.
     """
-    q = run.q if run.q0 is None else np.vstack([run.q0, run.q0, run.q])  # at rest before q0
-    if len(q) < 3 or len(run.t) < 2:
+    return _max_rate_ratio(run, robot, 2, robot.acceleration_limit)
+
+
+def max_jerk_ratio(run: PlanResult, robot: RobotModel) -> float:
+    """The largest |d³q/dt³_i| / (jerk limit of joint i) over the run, by third differences
+    of the periods from rest at q0 (as max_acceleration_ratio).
+
+    Args:
+        run: the tracking run.
+        robot: the robot, for its joint jerk limits.
+
+    Returns:
+        The largest jerk ratio (above 1: a limit is broken); 0 for fewer than four samples.
+    """
+    return _max_rate_ratio(run, robot, 3, robot.jerk_limit)
+
+
+def _max_rate_ratio(run: PlanResult, robot: RobotModel, order: int, limit: np.ndarray) -> float:
+    """The largest |order-th difference| / dt^order over `limit`, from rest at q0."""
+    q = run.q if run.q0 is None else np.vstack([*[run.q0] * order, run.q])  # at rest before
+    if len(q) < order + 1 or len(run.t) < 2:
         return 0.0
     motion = robot.difference(q[1:], q[:-1])
-    acceleration = np.abs(np.diff(motion, axis=0)) / (run.t[1] - run.t[0]) ** 2
-    return float(np.max(acceleration / robot.acceleration_limit))
+    rate = np.abs(np.diff(motion, order - 1, axis=0)) / (run.t[1] - run.t[0]) ** order
+    return float(np.max(rate / limit))
 
 
 def trace_columns(run: PlanResult) -> dict[str, np.ndarray]:

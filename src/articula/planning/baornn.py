@@ -117,9 +117,14 @@ class BeetleSearch:
             self._box, self._stop = None, NO_STOP
             return False
         robot = self.objective.scene.robot
-        self._box = self.rate.box(q, robot.lower, robot.upper)
-        change = self.rate.change
-        self._stop = NO_STOP if change is None else Stop(q, change, self.objective.sweep)
+        rate = self.rate
+        last = np.zeros_like(q) if rate.last_motion is None else rate.last_motion
+        self._box = rate.box(q, robot.lower, robot.upper)
+        jerk = np.zeros(0) if rate.jerk_change is None else rate.jerk_change
+        change = rate.change
+        self._stop = (
+            NO_STOP if change is None else Stop(q, change, self.objective.sweep, last, jerk)
+        )
         return True
 
     def _end_period(self, start: np.ndarray, q: np.ndarray, g: float) -> np.ndarray:

@@ -12,6 +12,7 @@ from typing import NamedTuple
 import numpy as np
 
 from articula.numba_cache import jit
+from articula.planning.rate_limits import braking_after, braking_path
 from articula.planning.task import orientation_error
 from articula.scene.compiled_clearance import _evaluate
 
@@ -53,7 +54,7 @@ class Problem(NamedTuple):
         self_d_min: hard clearance between the links of a checked pair [m].
         lower: lower bound of the projection box, shape (nq,) [rad].
         upper: upper bound of the projection box, shape (nq,) [rad].
-        stop: the braking check (objective.Stop: q_base, change, sweep).
+        stop: the braking check (objective.Stop: q_base, change, sweep, last, jerk).
         clearance: the compiled scene with the pairs that count (ClearanceInputs, packed).
         static_min: smallest distance of the pairs that never move, per kind, shape (2,) [m].
     """
@@ -102,9 +103,11 @@ def _task_error(ee, ee_R, reference):
 
 @jit()
 def stoppable(clipped, d, d_self, d_min, self_d_min, stop, clearance, static_min):
-    """Whether the arm, at `clipped` after this period's motion from stop's q_base, still ends
-    in Ω if every joint then brakes at its largest deceleration (the point where it stops is
-    evaluated only when the clearances left could be used up on the way).
+    """Whether the arm, at `clipped` after this period's motion from stop's q_base, stays in Ω
+    while every joint then brakes as hard as its limits let it: where it stops, or, with a
+    jerk limit (braking that first ramps up, so longer), at the end of every braking period
+    (rate_limits.braking_path); a point is measured only where the clearance left since the
+    last measured one could be used up on the way.
 
     Args:
         clipped: the configuration at the end of the period, shape (nq,) [rad].
@@ -114,7 +117,8 @@ def stoppable(clipped, d, d_self, d_min, self_d_min, stop, clearance, static_min
         self_d_min: the hard clearance between the links of a checked pair [m].
         stop: the braking check (objective.Stop: q_base, the period's start; change, each
             joint's largest change of motion per period, empty: no acceleration limit; sweep,
-            how far a shape point moves at most per unit of each joint's motion).
+            how far a shape point moves at most per unit of each joint's motion; last, the
+            motion before; jerk, the largest change of the change, empty: none).
         clearance: the compiled scene with the pairs that count (ClearanceInputs,
             packed).
         static_min: smallest distance of the pairs that never move, per kind, shape (2,) [m].
@@ -122,21 +126,27 @@ def stoppable(clipped, d, d_self, d_min, self_d_min, stop, clearance, static_min
     Returns:
         True when braking from `clipped` stays clear (or there is no acceleration limit).
     """
-    q_base, change, sweep = stop
+    q_base, change, sweep, last, jerk = stop
     if change.size == 0:
         return True
-    q_stop = clipped.copy()
-    travel = 0.0  # [m] the farthest any point of the arm moves while braking
-    for j in range(clipped.size):
-        if math.isfinite(change[j]):
-            m = clipped[j] - q_base[j]
-            q_stop[j] += m * abs(m) / (2.0 * change[j])  # m + (m - c) + ... ≤ m²/(2c) beyond
-            travel += sweep[j] * abs(q_stop[j] - clipped[j])
+    motion = clipped - q_base
+    if jerk.size == 0:  # braking at once: where it stops (each joint monotone on the way)
+        path = braking_after(motion, last, change, jerk).reshape(1, clipped.size)
+    else:  # braking ramped up: each period's end, as the period's own end is checked
+        path = braking_path(motion, last, change, jerk)
     room = min(d - d_min, d_self - max(self_d_min, SELF_CONTACT_MARGIN))
-    if room > travel:
-        return True
-    d_stop, d_self_stop, _, _ = _evaluate(q_stop, clearance, static_min)
-    return not outside_omega(d_stop, d_self_stop, d_min, self_d_min)
+    before = clipped
+    for k in range(path.shape[0]):
+        q_k = clipped + path[k]
+        for j in range(clipped.size):  # no point of the arm moves farther than this
+            room -= sweep[j] * abs(q_k[j] - before[j])
+        if room <= 0.0:  # the clearance left could be used up here: measure it
+            d_k, d_self_k, _, _ = _evaluate(q_k, clearance, static_min)
+            if outside_omega(d_k, d_self_k, d_min, self_d_min):
+                return False
+            room = min(d_k - d_min, d_self_k - max(self_d_min, SELF_CONTACT_MARGIN))
+        before = q_k
+    return True
 
 
 @jit(inline="always")

@@ -44,7 +44,7 @@ from articula.validation import (
 
 Method = Literal["baornn", "baornn-improved", "pinv", "dls", "qp"]
 METHODS: tuple[str, ...] = get_args(Method)  # every planning method, by its [planner] name
-Limits = Literal["velocity+acceleration", "velocity", "none"]
+Limits = Literal["velocity+acceleration+jerk", "velocity+acceleration", "velocity", "none"]
 Rpy = Annotated[list[Radians], Field(min_length=3, max_length=3)]
 Quaternion = Annotated[list[Finite], Field(min_length=4, max_length=4)]
 
@@ -141,12 +141,13 @@ class PlannerSpec(StrictModel):
         max_steps: most control periods a run may have (duration / dt).
         limits: "velocity+acceleration": the URDF's joint speed limits (scaled) and the
             robot's acceleration limits ([robot] acceleration_limits or accel_time), relative
-            to the last period's motion; "velocity": the speed limits alone; "none": BAORNN
-            moves as fast as the book's Algorithm 1 (the baselines' solvers always keep the
-            speed limits).
+            to the last period's motion; "velocity+acceleration+jerk": and the robot's jerk
+            limits ([robot] jerk_limits or jerk_time), relative to the last two periods';
+            "velocity": the speed limits alone; "none": BAORNN moves as fast as the book's
+            Algorithm 1 (the baselines' solvers always keep the speed limits).
         velocity_scale: fraction of the URDF joint speed limits, in (0, 1].
         max_acceleration: one acceleration limit for every joint that overrides the robot's
-            (limits = "velocity+acceleration" only); None: the robot's [rad/s²].
+            (limits with "acceleration" only); None: the robot's [rad/s²].
         approach: "auto": when the path starts away from the tool, the reference first moves
             from the tool to the path's start (the approach), then the path begins; "none":
             the path begins at once, as in the book.
@@ -205,7 +206,7 @@ class PlannerSpec(StrictModel):
             object.__setattr__(self, "settle", min(5.0, self.duration / 2))
         if self.settle >= self.duration:
             raise field_error("settle", f"must be shorter than duration = {self.duration} s")
-        if self.max_acceleration is not None and self.limits != "velocity+acceleration":
+        if self.max_acceleration is not None and "acceleration" not in self.limits:
             raise field_error(
                 "max_acceleration",
                 f"limits = {self.limits!r} keeps no acceleration limit; remove max_acceleration "
@@ -270,8 +271,8 @@ def _planner(spec: PlannerSpec, scene: Scene, seed: int) -> Planner:
 
 def rate_limits(spec: PlannerSpec, robot: RobotModel) -> RateLimits | None:
     """The joint speed limits of `robot` (its URDF's, times velocity_scale; a joint without
-    one has none) and, with limits = "velocity+acceleration", its acceleration limits
-    (max_acceleration for every joint when given), relative to the last period's motion.
+    one has none) and, as spec.limits says, its acceleration (max_acceleration for every joint
+    when given) and jerk limits, relative to the last periods' motions.
 
     Args:
         spec: the validated [planner] table.
@@ -285,11 +286,12 @@ def rate_limits(spec: PlannerSpec, robot: RobotModel) -> RateLimits | None:
         return None
     speeds = np.where(robot.velocity_limit > 0, robot.velocity_limit, np.inf)
     acceleration = None
-    if spec.limits == "velocity+acceleration":
+    if "acceleration" in spec.limits:
         acceleration = (
             robot.acceleration_limit if spec.max_acceleration is None else spec.max_acceleration
         )
-    return RateLimits(spec.velocity_scale * speeds, spec.dt, acceleration)
+    jerk = robot.jerk_limit if "jerk" in spec.limits else None
+    return RateLimits(spec.velocity_scale * speeds, spec.dt, acceleration, jerk)
 
 
 # "QpIkParams.safety" -> "planner.safety": the library's names of the [planner] keys.

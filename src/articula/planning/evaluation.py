@@ -9,27 +9,12 @@ import numpy as np
 import pinocchio as pin
 
 from articula.planning.baornn_kernel import outside_omega, stoppable
+from articula.planning.rate_limits import braking_after, braking_path
 from articula.scene.compiled_clearance import CompiledClearance
 from articula.scene.scene import Scene
 
 # (obstacle clearance [m], self clearance [m], end-effector position [m], rotation (3×3))
 Measured = tuple[float, float, np.ndarray, np.ndarray]
-
-
-def braking_travel(motion: np.ndarray, change: np.ndarray) -> np.ndarray:
-    """How far [rad] each joint moves on, after a period's `motion`, when it brakes at its
-    largest change of motion per period `change` (m·|m|/(2c), 0 where c is inf).
-
-    Args:
-        motion: the joint motion over the period, shape (nq,) [rad].
-        change: the largest change of motion per period, a·dt², shape (nq,) [rad].
-
-    Returns:
-        The signed travel until each joint stops, shape (nq,) [rad].
-    """
-    with np.errstate(divide="ignore", invalid="ignore"):
-        travel = motion * np.abs(motion) / (2.0 * change)
-    return np.where(np.isfinite(change), travel, 0.0)
 
 
 class CompiledEvaluation:
@@ -133,7 +118,8 @@ class SceneEvaluation:
     def brakes_clear(
         self, q: np.ndarray, d: float, d_self: float, stop: tuple, t: float, omega: tuple
     ) -> bool:
-        """Whether the point where braking from q ends is inside Ω (measured there).
+        """Whether braking from q stays inside Ω (baornn_kernel.stoppable's points, each
+        measured).
 
         Args:
             q: joint angles at the end of the period, shape (nq,) [rad].
@@ -147,10 +133,16 @@ class SceneEvaluation:
             Whether braking from q ends inside Ω.
         """
         d_min, self_d_min, obstacles = omega
-        q_base, change, _ = stop
-        q_stop = q + braking_travel(q - q_base, change)
-        d_stop, d_self_stop = self.scene.clearances(q_stop, t)
-        return not outside_omega(d_stop if obstacles else np.inf, d_self_stop, d_min, self_d_min)
+        q_base, change, _, last, jerk = stop
+        motion = q - q_base
+        path = braking_path(motion, last, change, jerk)
+        if not jerk.size:  # braking at once: where it stops (as baornn_kernel.stoppable)
+            path = braking_after(motion, last, change, jerk)[None]
+        for offset in path:
+            d_k, d_self_k = self.scene.clearances(q + offset, t)
+            if outside_omega(d_k if obstacles else np.inf, d_self_k, d_min, self_d_min):
+                return False
+        return True
 
 
 def evaluation_for(scene: Scene, use_compiled: bool) -> CompiledEvaluation | SceneEvaluation:

@@ -14,9 +14,9 @@ from articula.planning.baornn_kernel import Problem, Reference, outside_omega
 from articula.planning.evaluation import (
     CompiledEvaluation,
     SceneEvaluation,
-    braking_travel,
     evaluation_for,
 )
+from articula.planning.rate_limits import braking_after
 from articula.planning.task import Target, Task, as_target, target_arrays
 from articula.robots.sweep import joint_sweep
 from articula.scene.compiled_clearance import CompiledClearance
@@ -35,14 +35,19 @@ class Stop(NamedTuple):
             empty: no acceleration limit, no check.
         sweep: how far a point of the arm moves at most per unit of each joint's motion,
             shape (nq,) [m/rad] (robots.sweep.joint_sweep).
+        last: the motion of the period before, shape (nq,) [rad] (zeros: from rest).
+        jerk: each joint's largest change of its change of motion per period, j·dt³, shape
+            (nq,) [rad]; empty: no jerk limit (braking starts at once).
     """
 
     q_base: np.ndarray
     change: np.ndarray
     sweep: np.ndarray
+    last: np.ndarray
+    jerk: np.ndarray
 
 
-NO_STOP = Stop(np.zeros(0), np.zeros(0), np.zeros(0))
+NO_STOP = Stop(np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0))
 
 
 @dataclass(frozen=True)
@@ -234,5 +239,6 @@ def _braking_box(box: Box, stop: Stop) -> Box:
         return box
     low, high = box[0] - stop.q_base, box[1] - stop.q_base
     widest = np.maximum(np.abs(low), np.abs(high))
-    extra = np.abs(braking_travel(widest, stop.change))
+    # The longest braking: the widest motion, still speeding up as fast as it can.
+    extra = np.abs(braking_after(widest, widest - stop.change, stop.change, stop.jerk))
     return box[0] - extra, box[1] + extra

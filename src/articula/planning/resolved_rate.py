@@ -9,9 +9,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from articula.planning.clearance import ClearanceRows, RowSource
-from articula.planning.evaluation import braking_travel
 from articula.planning.planner import WARM_UP_STEPS
-from articula.planning.rate_limits import RateLimits
+from articula.planning.rate_limits import RateLimits, braking_after
 from articula.planning.reference_velocity import task_rows
 from articula.planning.task import Target, Task, as_target
 from articula.scene.scene import Scene
@@ -172,7 +171,10 @@ class ResolvedRate:
         clear = self._clearances(q_new, t)
         change = self._limits.change
         if change is not None:
-            end = q_new + braking_travel(q_new - q, change)
+            limits = self._limits
+            last = np.zeros_like(q) if limits.last_motion is None else limits.last_motion
+            jerk = np.zeros(0) if limits.jerk_change is None else limits.jerk_change
+            end = q_new + braking_after(q_new - q, last, change, jerk)
             clear = np.minimum(clear, self._clearances(end, t))
         return clear
 

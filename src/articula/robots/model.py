@@ -23,29 +23,10 @@ from articula.robots._urdf_kinematics import (
     _prepare_urdf,
     _unbounded,
 )
+from articula.robots.limits import ACCEL_TIME, JERK_TIME, rise_limit
 from articula.robots.urdf_geometry import collision_shapes
 
 BUILTIN = {"iiwa14": ("iiwa14/iiwa14.urdf", "iiwa_link_ee")}
-# [s] Without stated acceleration limits, a joint may reach its URDF speed limit from rest in
-# no less than this: limit / ACCEL_TIME [rad/s²] (a Franka's 7.5-20 rad/s² is 0.1-0.3 s).
-ACCEL_TIME = 0.25
-
-
-def acceleration_from_speed(speeds: np.ndarray, accel_time: float) -> np.ndarray:
-    """The acceleration [rad/s² or m/s²] that reaches each speed limit from rest in
-    `accel_time` [s]: speed / accel_time; inf where a joint has no speed limit (0 or inf).
-
-    Args:
-        speeds: joint speed limits, shape (nq,) [rad/s or m/s].
-        accel_time: time from rest to the speed limit [s], > 0.
-
-    Returns:
-        The acceleration limits, shape (nq,).
-    """
-    if not (np.isfinite(accel_time) and accel_time > 0):
-        raise ConfigError("accel_time", f"must be finite and > 0 s (got {accel_time})")
-    with np.errstate(over="ignore"):  # a speed near the float range has no useful limit
-        return np.where(np.asarray(speeds) > 0, np.asarray(speeds) / accel_time, np.inf)
 
 
 @dataclass(frozen=True, eq=False)
@@ -84,8 +65,11 @@ class RobotModel:
     Attributes:
         continuous: True for each continuous joint, shape (nq,).
         acceleration_limit: joint acceleration limits [rad/s² or m/s²], inf for none; by
-            default each URDF speed limit reached from rest in ACCEL_TIME (scene files set it
-            from [robot] acceleration_limits or accel_time).
+            default each URDF speed limit reached from rest in ACCEL_TIME (robots.limits;
+            scene files set it from [robot] acceleration_limits or accel_time).
+        jerk_limit: joint jerk limits [rad/s³ or m/s³], inf for none; by default each
+            acceleration limit reached from zero in JERK_TIME (scene files set it from
+            [robot] jerk_limits or jerk_time).
     """
 
     def __init__(
@@ -104,7 +88,8 @@ class RobotModel:
         self.ee_frame = ee_frame
         self.ee_frame_id = model.getFrameId(ee_frame)
         self.continuous = np.array([name in continuous for name in self.joint_names], dtype=bool)
-        self.acceleration_limit = acceleration_from_speed(model.velocityLimit, ACCEL_TIME)
+        self.acceleration_limit = rise_limit(model.velocityLimit, ACCEL_TIME)
+        self.jerk_limit = rise_limit(self.acceleration_limit, JERK_TIME, "jerk_time")
 
     @classmethod
     def from_urdf(

@@ -20,7 +20,7 @@ import tomli_w
 
 from articula import __version__
 from articula.errors import ConfigError
-from articula.runs.folders import CONFIG, RECORD, TRACE
+from articula.runs.folders import CONFIG, RECORD, TABLES, TRACE
 from articula.runs.registry import Result
 
 _VERSIONED = (
@@ -74,10 +74,12 @@ def build_record(
         error: why the run could not be done, or None for a run that was done.
 
     Returns:
-        The record: experiment, seed, config_hash, metrics, versions, wall_time_s and, for a
-        run that could not be done, error.
+        The record: experiment, seed, config_hash, metrics, versions, wall_time_s, the
+        result's details, `tables` (the further files, when there are any) and, for a run
+        that could not be done, error.
     """
     record = {
+        **result.details,
         "experiment": config["experiment"],
         "seed": config.get("seed"),
         "config_hash": config_hash(config),
@@ -85,6 +87,8 @@ def build_record(
         "versions": package_versions(),
         "wall_time_s": wall_time,
     }
+    if result.tables:
+        record["tables"] = sorted(result.tables)
     if error is not None:
         record["error"] = error
     return record
@@ -95,6 +99,7 @@ def write_run(
     config: Mapping[str, Any],
     record: Mapping[str, Any],
     trace: Mapping[str, np.ndarray],
+    tables: Mapping[str, Mapping[str, np.ndarray]] | None = None,
 ) -> None:
     """Write a complete run folder; record.json goes last and marks the run finished.
 
@@ -105,13 +110,17 @@ def write_run(
         config: the run's full config, written as config.toml.
         record: the run's record (build_record), written as record.json.
         trace: the run's time-series columns by name, equally long, written as trace.parquet.
+        tables: further time series by file name (Result.tables), each written beside it.
     """
     make_folder(folder)
     atomic_write(folder / CONFIG, tomli_w.dumps(dict(config)).encode())
-    table = pa.table({k: np.asarray(v) for k, v in trace.items()})
-    sink = pa.BufferOutputStream()
-    pq.write_table(table, sink)
-    atomic_write(folder / TRACE, sink.getvalue().to_pybytes())
+    tables = tables or {}
+    for stale in TABLES - set(tables):  # an earlier run's table this run does not write
+        (folder / stale).unlink(missing_ok=True)
+    for name, columns in {TRACE: trace, **tables}.items():
+        sink = pa.BufferOutputStream()
+        pq.write_table(pa.table({k: np.asarray(v) for k, v in columns.items()}), sink)
+        atomic_write(folder / name, sink.getvalue().to_pybytes())
     atomic_write(folder / RECORD, json.dumps(record, indent=2).encode())
 
 
@@ -131,7 +140,8 @@ def make_folder(path: Path) -> None:
 
 def is_finished(folder: Path, config_hash_: str | None = None) -> bool:
     """True when the run folder holds a complete run: a readable record.json (of the config
-    with hash `config_hash_`, when given) beside its config.toml and a readable trace.parquet.
+    with hash `config_hash_`, when given) beside its config.toml, a readable trace.parquet and
+    every further table the record lists.
 
     A folder that fails any check (a run killed between files, a truncated or foreign file)
     is not finished, and resuming recomputes it.
@@ -145,7 +155,8 @@ def is_finished(folder: Path, config_hash_: str | None = None) -> bool:
     """
     try:
         record = read_record(folder)
-        pq.read_metadata(folder / TRACE)
+        for name in [TRACE, *record.get("tables", [])]:
+            pq.read_metadata(folder / name)
         complete = (folder / CONFIG).is_file() and isinstance(record.get("metrics"), dict)
     except (OSError, ValueError, AttributeError, pa.ArrowException):
         return False

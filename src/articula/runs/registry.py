@@ -9,7 +9,7 @@ one's own can add experiments without touching articula.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cache
 from importlib import metadata
 from pathlib import Path
@@ -27,15 +27,22 @@ Progress = Callable[[int, int], None]  # (done, total) of a run's steps
 
 @dataclass(frozen=True)
 class Result:
-    """What an experiment returns: scalar metrics and equally long time-series columns.
+    """What an experiment returns: scalar metrics and equally long time-series columns, and
+    optionally more tables and record entries.
 
     Attributes:
         metrics: the run's scalar metrics by name (units as the experiment defines them).
         trace: the run's time-series columns by name, each shape (samples,).
+        tables: further time series by file name ("servo.parquet"), each its columns by name,
+            written beside trace.parquet.
+        details: further entries of record.json beside metrics (JSON-ready, e.g. per-joint
+            limits), by key.
     """
 
     metrics: dict[str, float]
     trace: dict[str, np.ndarray]
+    tables: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
+    details: dict[str, Any] = field(default_factory=dict)
 
 
 def _no_paths(data: dict[str, Any], base_dir: Path) -> dict[str, Any]:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Mapping, Sequence
 from contextlib import AbstractContextManager, nullcontext
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -24,17 +24,19 @@ FLAT_LIST_LIMIT = 16  # results.parquet spreads a config list this long or short
 
 @dataclass(frozen=True)
 class RunOutput:
-    """A finished run as it travels back from a worker: config, record and trace.
+    """A finished run as it travels back from a worker: config, record, trace and tables.
 
     Attributes:
         config: the run's full config (defaults filled in), with its `experiment` key.
         record: the run's record (records.build_record).
         trace: the run's time-series columns by name; empty for a run that could not be done.
+        tables: further time series by file name (Result.tables).
     """
 
     config: dict[str, Any]
     record: dict[str, Any]
     trace: dict[str, np.ndarray]
+    tables: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
 
 
 def execute(
@@ -57,7 +59,8 @@ def execute(
     with named_by_file(where):
         result = exp.run(model, progress=progress)
     wall = time.perf_counter() - start
-    return RunOutput(full, records.build_record(full, result, wall), result.trace)
+    record = records.build_record(full, result, wall)
+    return RunOutput(full, record, result.trace, result.tables)
 
 
 def named_by_file(where: str) -> AbstractContextManager[None]:
@@ -135,7 +138,7 @@ def run_to_folder(
     check_out(out, "run", force)
     output = execute(config, where, progress)
     with claimed(out, "run", force):
-        records.write_run(out, output.config, output.record, output.trace)
+        records.write_run(out, output.config, output.record, output.trace, output.tables)
     return output.record
 
 
@@ -178,7 +181,7 @@ def run_sweep(
             progress(done, len(configs))
         for output in execute_all(execute_or_fail, todo, workers, dask):
             folder = out / output.record["config_hash"]
-            records.write_run(folder, output.config, output.record, output.trace)
+            records.write_run(folder, output.config, output.record, output.trace, output.tables)
             done += 1
             if progress:
                 progress(done, len(configs))

@@ -14,7 +14,8 @@ from articula.geometry.meshes import convex_parts, load_mesh
 from articula.geometry.poses import pose
 from articula.geometry.shapes import ConvexShape, box, capsule, cylinder, sphere
 from articula.limits import MAX_DECOMPOSE_VERTICES, MAX_LENGTH, MAX_LINKS, MAX_SCALE, MIN_SCALE
-from articula.robots.model import ACCEL_TIME, RobotModel, acceleration_from_speed
+from articula.robots.limits import ACCEL_TIME, JERK_TIME, rise_limit
+from articula.robots.model import RobotModel
 from articula.scene.obstacles import Obstacle
 from articula.scene.pairs import link_pairs
 from articula.scene.scene import SELF_D_MIN, Metric, Scene
@@ -75,6 +76,10 @@ class RobotSpec(StrictModel):
             [rad/s² or m/s²]; None: each joint's URDF speed limit over accel_time.
         accel_time: time from rest to a joint's URDF speed limit when acceleration_limits
             is not given [s].
+        jerk_limits: joint jerk limits, one for every joint or one per joint [rad/s³ or
+            m/s³]; None: each acceleration limit over jerk_time.
+        jerk_time: time from zero to a joint's acceleration limit when jerk_limits is not
+            given [s].
         allow_pairs: [a, b] link name pairs never checked for self-collision.
         self_collision_samples: random configurations the allowed-collision matrix is built on.
         self_collision_margin: a link pair never closer than this over the samples is not
@@ -98,6 +103,8 @@ class RobotSpec(StrictModel):
     self_d_min: Annotated[float, Field(ge=0, le=MAX_LENGTH, allow_inf_nan=False)] = SELF_D_MIN
     acceleration_limits: Positive | list[Positive] | None = None
     accel_time: Positive = ACCEL_TIME
+    jerk_limits: Positive | list[Positive] | None = None
+    jerk_time: Positive = JERK_TIME
     allow_pairs: list[Annotated[list[str], Field(min_length=2, max_length=2)]] = Field(
         default_factory=list
     )
@@ -216,7 +223,10 @@ def build_scene(
                 offset,
                 decompose=r.decompose,
             )
-        robot.acceleration_limit = _acceleration_limits(r, robot)
+        robot.acceleration_limit = _limit(
+            r.acceleration_limits, robot.velocity_limit, r.accel_time, _ACCELERATION
+        )
+        robot.jerk_limit = _limit(r.jerk_limits, robot.acceleration_limit, r.jerk_time, _JERK)
     q0 = robot.check_q(r.q0 if r.q0 is not None else np.zeros(robot.nq), "robot.q0")
     obstacles = []
     for i, o in enumerate(spec.obstacles):
@@ -248,18 +258,28 @@ def robot_self_collision(spec: SceneSpec, robot: RobotModel) -> SelfCollisionMat
         )
 
 
-def _acceleration_limits(spec: RobotSpec, robot: RobotModel) -> np.ndarray:
-    """The joint acceleration limits [rad/s²] of [robot]: acceleration_limits (one number or
-    one per joint), else each URDF speed limit over accel_time."""
-    if spec.acceleration_limits is None:
-        return acceleration_from_speed(robot.velocity_limit, spec.accel_time)
-    limits = np.asarray(spec.acceleration_limits, dtype=float)
+# A [robot] limit's key, the key of its rise time, and its unit.
+_ACCELERATION = ("acceleration_limits", "accel_time", "rad/s²")
+_JERK = ("jerk_limits", "jerk_time", "rad/s³")
+
+
+def _limit(
+    stated: float | list[float] | None,
+    below: np.ndarray,
+    rise_time: float,
+    keys: tuple[str, str, str],
+) -> np.ndarray:
+    """A [robot] limit per joint: the stated one (one number or one per joint), else the limit
+    `below` reached from zero in rise_time (robots.limits.rise_limit)."""
+    key, time_key, unit = keys
+    if stated is None:
+        return rise_limit(below, rise_time, time_key)
+    limits = np.asarray(stated, dtype=float)
     if limits.ndim == 0:
-        return np.full(robot.nq, float(limits))
-    if limits.shape != (robot.nq,):
+        return np.full(below.size, float(limits))
+    if limits.shape != below.shape:
         raise ConfigError(
-            "acceleration_limits",
-            f"needs one number or {robot.nq}, one per joint [rad/s²] (got {limits.size})",
+            key, f"needs one number or {below.size}, one per joint [{unit}] (got {limits.size})"
         )
     return limits
 
