@@ -29,6 +29,7 @@ LAYERS = {
     "planning": 7,
     "loops": 8,
     "runs": 9,
+    "sim": 9,
     "rigs": 10,
     "experiments": 11,
     "book": 12,

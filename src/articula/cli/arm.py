@@ -38,7 +38,8 @@ def plan(
     """Track the scene's reference path with its planner; writes a run folder (trace + record).
 
     A motion with a colliding step (a link in an obstacle, or two links of a checked pair
-    touching) still writes its run folder, then exits with status 4.
+    touching), or one the dynamics twin ([plant]) touches something in, still writes its run
+    folder, then exits with status 4.
 
     \b
     Example: articula plan src/articula/book/ch1/configs/circle_two_obstacles.toml --out runs/circle
@@ -87,4 +88,12 @@ def plan(
             f"the arm collides with itself in {int(m['self_collisions'])} steps (deepest "
             f"{-1e3 * m['min_self_clearance']:.1f} mm); the run folder {out_dir} is written; "
             "pass --allow-collisions to accept it, or raise robot.self_d_min"
+        )
+    if m.get("plant_contacts") and not allow_collisions:
+        from articula.errors import CollisionError
+
+        raise CollisionError(
+            f"the twin's arm touched an obstacle or itself in {int(m['plant_contacts'])} "
+            f"periods (MuJoCo's contacts); the run folder {out_dir} is written; pass "
+            "--allow-collisions to accept it, or raise planner.d_min or the plant's stiffness"
         )

@@ -14,7 +14,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -66,6 +66,21 @@ class ServoSpec(StrictModel):
     rate: Annotated[float, Field(gt=0, le=100_000, allow_inf_nan=False)]
 
 
+class PlantSpec(StrictModel):
+    """[plant]: the arm the commands drive; "mujoco": the dynamics twin (sim/twin.py, the
+    `sim` extra), fed the servo stream, its measured joints closing the loop.
+
+    Attributes:
+        type: "mujoco".
+        stiffness: each servo's kp over its joint's effort limit [1/rad].
+        damping: each servo's kv over its kp [s].
+    """
+
+    type: Literal["mujoco"]
+    stiffness: Annotated[float, Field(gt=0, le=1e6, allow_inf_nan=False)] = 100.0
+    damping: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)] = 0.05
+
+
 class PlanConfig(SceneSpec):
     """A scene with the path to track and the planner that tracks it.
 
@@ -83,18 +98,25 @@ class PlanConfig(SceneSpec):
             the run's duration.
         servo: the [servo] table: the servo stream to write (planner.limits then defaults
             to "velocity+acceleration+jerk", the only one it takes); None: none.
+        plant: the [plant] table: the dynamics twin the stream drives (needs [servo]); None:
+            the arm is where it was told.
     """
 
     seed: Seed | None = None
     trajectory: TrajectorySpec
     planner: PlannerSpec = PlannerSpec()
     servo: ServoSpec | None = None
+    plant: PlantSpec | None = None
 
     @model_validator(mode="after")
     def _one_seed(self) -> PlanConfig:
         seed = self.seed if self.seed is not None else self.planner.seed
         object.__setattr__(self, "seed", 0 if seed is None else seed)
         object.__setattr__(self, "planner", self.planner.model_copy(update={"seed": None}))
+        if self.plant is not None and self.servo is None:
+            raise field_error(
+                "servo", "a [plant] is driven by the servo stream: add [servo] rate = 1000"
+            )
         if self.servo is not None:
             ticks = self.servo.rate * self.planner.dt
             if round(ticks) < 1 or abs(ticks - round(ticks)) > 1e-6:
@@ -233,8 +255,17 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
     with fields_as(_CONFIG_PATHS):
         check_reach(plan.scene.robot, plan.targets.positions, p.duration)
         planner = make_planner(p, plan.scene, config.seed)
+        arm = None if config.plant is None else _twin_arm(config, plan)
         run = track(
-            planner, plan.reference, plan.q0, p.dt, lead + p.duration, p.max_steps, progress, lead
+            planner,
+            plan.reference,
+            plan.q0,
+            p.dt,
+            lead + p.duration,
+            p.max_steps,
+            progress,
+            lead,
+            arm,
         )
     metrics = tracking_metrics(
         run, plan.scene.robot, p.settle or 0.0, planner.iterations, plan.targets.cone
@@ -255,15 +286,34 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
             f"= {p.orientation_tolerance} rad",
             "trajectory",
         )
+    trace = trace_columns(run)
+    if arm is not None:
+        metrics |= arm.metrics(run, plan.scene, p.settle or 0.0)
+        trace |= arm.columns()
     if config.servo is None:
-        return Result(metrics, trace_columns(run), details={"limits": _limits(plan.scene)})
+        return Result(metrics, trace, details={"limits": _limits(plan.scene)})
     stream, servo = run_stream(run, plan.scene.robot, config.servo.rate)
     return Result(
         metrics | servo,
-        trace_columns(run),
+        trace,
         tables={SERVO: stream.columns()},
         details={"limits": _limits(plan.scene)},
     )
+
+
+def _twin_arm(config: PlanConfig, plan: PlanSetup) -> Any:
+    """The plan's [plant]: the MuJoCo twin driven by the servo stream (sim.twin_arm)."""
+    try:  # the `sim` extra: imported only when asked for
+        from articula.sim.twin import ServoGains
+        from articula.sim.twin_arm import TwinArm
+    except ImportError as exc:
+        raise ConfigError(
+            "plant.type",
+            f'the MuJoCo twin needs the sim extra: pip install "articula[sim]" ({exc})',
+        ) from None
+
+    gains = ServoGains(config.plant.stiffness, config.plant.damping)
+    return TwinArm(plan.scene, plan.q0, config.planner.dt, config.servo.rate, gains)
 
 
 def load_plan(path: Path, servo_rate: float | None = None) -> dict[str, Any]:

@@ -64,9 +64,11 @@ def track(
     max_steps: int = MAX_STEPS,
     progress: Callable[[int, int], None] | None = None,
     path_start: float = 0.0,
+    arm: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> PlanResult:
     """Follow `trajectory` from q0 [rad] for `duration` [s], one step per `dt` [s] of an
-    OnlineController, the object a live loop uses.
+    OnlineController, the object a live loop uses; with an `arm`, each period's command is
+    sent to it and the joints it measures close the loop (OnlineController.step's q_measured).
 
     Args:
         planner: the planner that computes each period's configuration.
@@ -77,9 +79,11 @@ def track(
         max_steps: most periods allowed; a longer run is refused before anything is allocated.
         progress: called as progress(done, total) every hundredth of the run; None: silent.
         path_start: when the path itself begins (an Approach's duration) [s].
+        arm: command (n,) [rad] -> the joints measured at the end of its period [rad]
+            (sim.twin.TwinArm); None: the arm is where it was told.
 
     Returns:
-        The run's time series.
+        The run's time series (q: the commands).
     """
     if not (np.isfinite(dt) and dt > 0):
         raise ConfigError("dt", f"must be finite and > 0 s (got {dt})")
@@ -105,16 +109,18 @@ def track(
     orientation = np.zeros(steps) if task.kind != "position" else None
     planner_seconds = first_period_seconds = 0.0
     every = max(1, steps // 100)
+    measured = None
     for n, tn in enumerate(t):
         if progress is not None and n % every == 0:
             progress(n, steps)
         target = trajectory(tn)
         start = time.perf_counter()
-        q = controller.step(target)
+        q = controller.step(target, q_measured=measured)
         if n == 0:
             first_period_seconds = time.perf_counter() - start
         else:
             planner_seconds += time.perf_counter() - start
+        measured = None if arm is None else arm(q)
         qs[n] = q
         pose = robot.ee_pose(q)
         x[n] = pose[:3, 3]

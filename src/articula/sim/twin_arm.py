@@ -1,0 +1,111 @@
+"""A plan's arm as the twin: each period's command streamed to the servo rate and played on the
+MuJoCo twin, the joints it measures handed back to the planner (loops.tracking.track's `arm`),
+and what the twin did recorded for the run's trace and metrics.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from articula.loops.servo import ServoLimits, ServoStream
+from articula.loops.tracking import PlanResult
+from articula.scene.scene import Scene
+from articula.sim.twin import ServoGains, Twin
+
+__all__ = ["TwinArm"]
+
+
+class TwinArm:
+    """The arm of a plan under rigid-body dynamics, one control period per call.
+
+    Args:
+        scene: the robot and its obstacles.
+        q0: where the arm starts, at rest, shape (n,) [rad].
+        dt: the control period [s].
+        rate: the servo rate [Hz], a whole number of ticks per period.
+        gains: the joint servos' gains.
+
+    Attributes:
+        twin: the MuJoCo twin.
+        stream: the servo stream its commands go through.
+        measured: the joints measured at the end of each period so far, one (n,) row each.
+        torque: the joint torques at the end of each period so far [N·m].
+        contacts: the most contacts MuJoCo saw during each period so far.
+        torque_ratio: the largest |torque| / effort limit over every tick so far.
+    """
+
+    def __init__(
+        self,
+        scene: Scene,
+        q0: np.ndarray,
+        dt: float,
+        rate: float,
+        gains: ServoGains | None = None,
+    ) -> None:
+        self.twin = Twin(scene, rate, gains)
+        self.twin.reset(q0)
+        self.stream = ServoStream(ServoLimits.of(scene.robot), dt, rate)
+        self.stream.reset(q0)
+        self.measured: list[np.ndarray] = []
+        self.torque: list[np.ndarray] = []
+        self.contacts: list[int] = []
+        self.torque_ratio = 0.0
+
+    def __call__(self, command: np.ndarray) -> np.ndarray:
+        """Play one period's command on the twin.
+
+        Args:
+            command: the period's joint set-point, shape (n,) [rad].
+
+        Returns:
+            The joints measured at the end of the period, shape (n,) [rad].
+        """
+        twin, most = self.twin, 0
+        start = len(self.measured) * self.stream.dt  # this period's time [s]
+        for i, (q_ref, qd_ref, _) in enumerate(self.stream.period(command)):
+            twin.place_obstacles(start + (i + 1) * self.stream.dt / self.stream.ticks)
+            twin.step(q_ref, qd_ref)
+            most = max(most, twin.contacts())
+            self.torque_ratio = max(
+                self.torque_ratio, float(np.max(np.abs(twin.torque) / twin.effort))
+            )
+        self.measured.append(twin.q)
+        self.torque.append(twin.torque)
+        self.contacts.append(most)
+        return self.measured[-1]
+
+    def columns(self) -> dict[str, np.ndarray]:
+        """The trace's columns of the twin: qm_1..qm_n [rad], tau_1..tau_n [N·m], contacts.
+
+        Returns:
+            Column name -> one value per period.
+        """
+        measured, torque = np.array(self.measured), np.array(self.torque)
+        columns = {f"qm_{j + 1}": measured[:, j] for j in range(measured.shape[1])}
+        columns |= {f"tau_{j + 1}": torque[:, j] for j in range(torque.shape[1])}
+        return columns | {"contacts": np.array(self.contacts, dtype=float)}
+
+    def metrics(self, run: PlanResult, scene: Scene, settle: float) -> dict[str, float]:
+        """What the twin did, against the run's reference.
+
+        Args:
+            run: the tracking run (its reference and times).
+            scene: the scene, for the measured clearance and tool.
+            settle: time after the path's start from which the run counts as settled [s].
+
+        Returns:
+            plant_rms_error (the measured tool against the reference once settled [m]),
+            plant_min_clearance (articula's clearance at the measured joints [m]),
+            plant_contacts (periods in which MuJoCo saw a contact) and max_torque_ratio.
+        """
+        robot = scene.robot
+        tool = np.array([robot.ee_position(q) for q in self.measured])
+        settled = run.t >= run.path_start + settle
+        error = np.linalg.norm(tool - run.x_ref, axis=1)[settled]
+        clearance = [scene.clearances(q, t)[0] for q, t in zip(self.measured, run.t, strict=True)]
+        return {
+            "plant_rms_error": float(np.sqrt(np.mean(error**2))) if error.size else 0.0,
+            "plant_min_clearance": float(np.min(clearance)),
+            "plant_contacts": float(np.count_nonzero(self.contacts)),
+            "max_torque_ratio": self.torque_ratio,
+        }
