@@ -10,7 +10,6 @@ import signal
 import socket
 import subprocess
 import sys
-import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -105,8 +104,20 @@ def open_page(browser, url: str, wait_for: str = "closest:"):
     page.goto(url)
     page.get_by_text("Connected").wait_for(timeout=60_000)
     page.get_by_text(wait_for).first.wait_for(timeout=60_000)
-    time.sleep(3.0)  # software WebGL draws a few frames
+    wait_for_frames(page, 30)  # software WebGL draws a few frames
     return page
+
+
+def wait_for_frames(page, frames: int) -> None:
+    """Return once the page has drawn `frames` more animation frames (an event the page
+    signals, however slowly a loaded machine draws them)."""
+    page.evaluate(
+        """(count) => new Promise((done) => {
+            const next = () => (--count <= 0 ? done() : requestAnimationFrame(next));
+            requestAnimationFrame(next);
+        })""",
+        frames,
+    )
 
 
 def screenshot(page) -> np.ndarray:
@@ -115,7 +126,7 @@ def screenshot(page) -> np.ndarray:
     from PIL import Image
 
     page.bring_to_front()
-    page.wait_for_timeout(1000)  # a few frames of software WebGL
+    wait_for_frames(page, 10)  # a few frames of software WebGL, once in front
     return np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB")).astype(int)
 
 

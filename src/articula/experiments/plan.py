@@ -21,7 +21,7 @@ from pydantic import Field, model_validator
 
 from articula.errors import ConfigError, InfeasibleError
 from articula.loops.online import OnlineController
-from articula.loops.servo import run_stream
+from articula.loops.servo import run_stream, ticks_per_period
 from articula.loops.tracking import trace_columns, track, tracking_metrics
 from articula.planning.approach import Approach, approach
 from articula.planning.config import (
@@ -118,14 +118,10 @@ class PlanConfig(SceneSpec):
                 "servo", "a [plant] is driven by the servo stream: add [servo] rate = 1000"
             )
         if self.servo is not None:
-            ticks = self.servo.rate * self.planner.dt
-            if round(ticks) < 1 or abs(ticks - round(ticks)) > 1e-6:
-                raise field_error(
-                    "servo.rate",
-                    f"servo.rate = {self.servo.rate:g} Hz is not a whole number of ticks per "
-                    f"planner.dt = {self.planner.dt:g} s; use a multiple of "
-                    f"{1 / self.planner.dt:g} Hz",
-                )
+            try:
+                ticks_per_period(self.servo.rate, self.planner.dt)
+            except ConfigError as exc:
+                raise field_error(exc.field, exc.problem) from None
             if "limits" not in self.planner.model_fields_set:  # a stream keeps the jerk limits
                 limits = {"limits": "velocity+acceleration+jerk"}
                 object.__setattr__(self, "planner", self.planner.model_copy(update=limits))

@@ -28,7 +28,15 @@ from articula.loops.tracking import PlanResult
 from articula.planning.rate_limits import RateLimits
 from articula.robots.model import RobotModel
 
-__all__ = ["LAG_PERIODS", "ServoLimits", "ServoStream", "ServoTrace", "run_stream", "servo_trace"]
+__all__ = [
+    "LAG_PERIODS",
+    "ServoLimits",
+    "ServoStream",
+    "ServoTrace",
+    "run_stream",
+    "servo_trace",
+    "ticks_per_period",
+]
 
 LAG_PERIODS = 2  # a set-point commanded at t is passed at t + LAG_PERIODS · dt
 ROUND_OFF = 1e-9  # [rad] a set-point this close to the limits' box keeps them
@@ -108,18 +116,11 @@ class ServoStream:
     """
 
     def __init__(self, limits: ServoLimits, dt: float, rate: float) -> None:
-        ticks = round(rate * dt)
-        if ticks < 1 or abs(ticks - rate * dt) > 1e-6:
-            raise ConfigError(
-                "servo.rate",
-                f"{rate:g} Hz is not a whole number of ticks per {dt:g} s period; "
-                f"use a multiple of {1 / dt:g} Hz",
-            )
-        self.limits, self.dt, self.ticks = limits, dt, ticks
+        self.limits, self.dt, self.ticks = limits, dt, ticks_per_period(rate, dt)
         self.clipped = 0
         self._box = RateLimits(limits.velocity, dt, limits.acceleration, limits.jerk)
         self._points: np.ndarray | None = None  # the last three control points
-        u = np.arange(1, ticks + 1) / ticks
+        u = np.arange(1, self.ticks + 1) / self.ticks
         self._basis = _basis(u, dt)
 
     def reset(self, q: np.ndarray) -> None:
@@ -157,6 +158,26 @@ class ServoStream:
         control = np.vstack([self._points, point])  # (4, n): this period's control points
         self._points = control[1:]
         return np.einsum("tdk,kn->tdn", self._basis, control)
+
+
+def ticks_per_period(rate: float, dt: float) -> int:
+    """How many servo ticks one control period holds.
+
+    Args:
+        rate: the servo rate [Hz].
+        dt: the control period [s].
+
+    Returns:
+        rate · dt, when it is a whole number ≥ 1 (else ConfigError naming servo.rate).
+    """
+    ticks = round(rate * dt)
+    if ticks < 1 or abs(ticks - rate * dt) > 1e-6:
+        raise ConfigError(
+            "servo.rate",
+            f"{rate:g} Hz is not a whole number of ticks per {dt:g} s period (planner.dt); "
+            f"use a multiple of {1 / dt:g} Hz",
+        )
+    return ticks
 
 
 def _basis(u: np.ndarray, dt: float) -> np.ndarray:

@@ -135,8 +135,9 @@ class SceneEvaluation:
         d_min, self_d_min, obstacles = omega
         q_base, change, _, last, jerk = stop
         motion = q - q_base
-        path = braking_path(motion, last, change, jerk)
-        if not jerk.size:  # braking at once: where it stops (as baornn_kernel.stoppable)
+        if jerk.size:
+            path = braking_path(motion, last, change, jerk)
+        else:  # braking at once: where it stops (as baornn_kernel.stoppable)
             path = braking_after(motion, last, change, jerk)[None]
         for offset in path:
             d_k, d_self_k = self.scene.clearances(q + offset, t)

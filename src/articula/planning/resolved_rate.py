@@ -4,6 +4,7 @@ keeps d_min and self_d_min."""
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -19,7 +20,7 @@ BACKTRACKS = 3  # halvings of a step that breaks a clearance before the arm brak
 
 
 @dataclass
-class ResolvedRate:
+class ResolvedRate(ABC):
     """A base for the resolved-rate planners: the scene, the clearance they keep, their task
     and limits, their counts, and what each period starts with (the reachable box, the rows
     near an obstacle, the task's rows) and ends with (the clearance check).
@@ -89,6 +90,7 @@ class ResolvedRate:
         self._clearances(q, 0.0)
         self.iterations, self.infeasible = counts
 
+    @abstractmethod
     def step(self, q: np.ndarray, target: Target, t: float) -> np.ndarray:
         """One control period (the subclass's).
 
@@ -100,7 +102,6 @@ class ResolvedRate:
         Returns:
             The joint angles after dt, shape (nq,) [rad].
         """
-        raise NotImplementedError
 
     def _begin(
         self, q: np.ndarray, target: Target | np.ndarray, t: float

@@ -31,7 +31,7 @@ class TwinArm:
         measured: the joints measured at the end of each period so far, one (n,) row each.
         torque: the joint torques at the end of each period so far [N·m].
         contacts: the most contacts MuJoCo saw during each period so far.
-        torque_ratio: the largest |torque| / effort limit over every tick so far.
+        peak_torque: each joint's largest |torque| over every tick so far [N·m].
     """
 
     def __init__(
@@ -49,7 +49,7 @@ class TwinArm:
         self.measured: list[np.ndarray] = []
         self.torque: list[np.ndarray] = []
         self.contacts: list[int] = []
-        self.torque_ratio = 0.0
+        self.peak_torque = np.zeros(len(q0))
 
     def __call__(self, command: np.ndarray) -> np.ndarray:
         """Play one period's command on the twin.
@@ -66,9 +66,7 @@ class TwinArm:
             twin.place_obstacles(start + (i + 1) * self.stream.dt / self.stream.ticks)
             twin.step(q_ref, qd_ref)
             most = max(most, twin.contacts())
-            self.torque_ratio = max(
-                self.torque_ratio, float(np.max(np.abs(twin.torque) / twin.effort))
-            )
+            np.maximum(self.peak_torque, np.abs(twin.data.qfrc_actuator), out=self.peak_torque)
         self.measured.append(twin.q)
         self.torque.append(twin.torque)
         self.contacts.append(most)
@@ -107,5 +105,5 @@ class TwinArm:
             "plant_rms_error": float(np.sqrt(np.mean(error**2))) if error.size else 0.0,
             "plant_min_clearance": float(np.min(clearance)),
             "plant_contacts": float(np.count_nonzero(self.contacts)),
-            "max_torque_ratio": self.torque_ratio,
+            "max_torque_ratio": float(np.max(self.peak_torque / self.twin.effort)),
         }
