@@ -58,3 +58,12 @@ def test_a_servo_stream_without_the_jerk_limits_is_one_line(cli, tmp_path, asser
     scene.write_text(SCENE.format(trajectory=CIRCLE, method="qp"))  # limits = "none"
     proc = cli("plan", scene, "--out", tmp_path / "run", "--servo-rate", "1000")
     assert_one_line_error(proc, "planner.limits", "velocity+acceleration+jerk")
+
+
+def test_a_stream_too_long_to_hold_is_refused_before_the_run(cli, tmp_path, assert_one_line_error):
+    scene = tmp_path / "scene.toml"
+    limited = "[servo]\nrate = 1000\nmax_samples = 5000\n"  # 1 s of plan at 1 kHz: 1000
+    scene.write_text(STREAMED.format(trajectory=CIRCLE, method="qp") + limited)
+    proc = cli("plan", scene, "--out", tmp_path / "run", "--servo-rate", "10000")  # 10000
+    assert_one_line_error(proc, "servo.max_samples")
+    assert not (tmp_path / "run").exists()

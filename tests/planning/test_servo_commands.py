@@ -1,8 +1,9 @@
 """What `articula plan --servo-rate 1000` would send to an arm's joint servo, with the jerk
 limits on, on the packaged chapter-1 scenes and a Franka Panda among obstacles: every method's
 set-points keep the speed, acceleration and jerk limits (by differences from rest at q0), the
-1 kHz stream keeps them too (by differences of servo.parquet's positions) and passes every
-set-point within a sixth of a period's change of motion two periods after it was commanded,
+1 kHz stream keeps them too (by differences of servo.parquet's positions), passes every
+set-point within a sixth of a period's change of motion two periods after it was commanded and
+ends at rest,
 and no link enters an obstacle, comes within d_min of one, or within self_d_min of another."""
 
 from __future__ import annotations
@@ -51,6 +52,8 @@ def assert_streamed_within_every_limit(result: Result, config: PlanConfig) -> No
         rate = np.abs(np.diff(streamed_q, order, axis=0)) / h**order
         assert np.all(rate <= limit * (1 + 1e-6)), order
     assert m["servo_max_jerk_ratio"] <= 1 + 1e-6 and m["max_jerk_ratio"] <= 1 + 1e-6
+    ends = [servo[f"{c}_{j + 1}"][-1] for c in ("qd", "qdd") for j in range(robot.nq)]
+    assert np.max(np.abs(ends)) < 1e-9  # the stream ends at rest
     assert m["servo_max_deviation"] <= np.max(robot.acceleration_limit) * dt**2 / 6 * (1 + 1e-6)
     assert m["servo_lag_s"] == pytest.approx(2 * dt) and m["servo_clipped"] == 0
     assert m["collisions"] == 0 and m["self_collisions"] == 0

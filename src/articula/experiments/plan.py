@@ -20,6 +20,7 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from articula.errors import ConfigError, InfeasibleError
+from articula.limits import MAX_SERVO_SAMPLES
 from articula.loops.online import OnlineController
 from articula.loops.servo import run_stream, ticks_per_period
 from articula.loops.tracking import trace_columns, track, tracking_metrics
@@ -61,9 +62,11 @@ class ServoSpec(StrictModel):
     Attributes:
         rate: the servo rate [Hz]: a whole number of ticks per control period (1000 for a
             Franka, 500 for a UR's servoJ).
+        max_samples: most samples the stream may have (planner.duration / dt · ticks).
     """
 
     rate: Annotated[float, Field(gt=0, le=100_000, allow_inf_nan=False)]
+    max_samples: Annotated[int, Field(ge=1, le=10**9)] = MAX_SERVO_SAMPLES
 
 
 class PlantSpec(StrictModel):
@@ -119,9 +122,17 @@ class PlanConfig(SceneSpec):
             )
         if self.servo is not None:
             try:
-                ticks_per_period(self.servo.rate, self.planner.dt)
+                ticks = ticks_per_period(self.servo.rate, self.planner.dt)
             except ConfigError as exc:
                 raise field_error(exc.field, exc.problem) from None
+            samples = self.planner.duration / self.planner.dt * ticks
+            if samples > self.servo.max_samples:
+                raise field_error(
+                    "servo.rate",
+                    f"{self.planner.duration:g} s at {self.servo.rate:g} Hz is {samples:.3g} "
+                    f"samples, more than servo.max_samples = {self.servo.max_samples}; lower "
+                    "the rate, shorten planner.duration or raise servo.max_samples",
+                )
             if "limits" not in self.planner.model_fields_set:  # a stream keeps the jerk limits
                 limits = {"limits": "velocity+acceleration+jerk"}
                 object.__setattr__(self, "planner", self.planner.model_copy(update=limits))

@@ -25,7 +25,7 @@ import numpy as np
 
 from articula.errors import ConfigError, ModelError
 from articula.loops.tracking import PlanResult
-from articula.planning.rate_limits import RateLimits
+from articula.planning.rate_limits import RateLimits, braking_path
 from articula.robots.model import RobotModel
 
 __all__ = [
@@ -111,6 +111,7 @@ class ServoStream:
 
     Attributes:
         ticks: servo samples per control period.
+        box: the limits' box each new control point is kept in (as the planners' is).
         clipped: set-points so far that broke a limit and were replaced by the nearest
             control point that keeps them.
     """
@@ -118,7 +119,7 @@ class ServoStream:
     def __init__(self, limits: ServoLimits, dt: float, rate: float) -> None:
         self.limits, self.dt, self.ticks = limits, dt, ticks_per_period(rate, dt)
         self.clipped = 0
-        self._box = RateLimits(limits.velocity, dt, limits.acceleration, limits.jerk)
+        self.box = RateLimits(limits.velocity, dt, limits.acceleration, limits.jerk)
         self._points: np.ndarray | None = None  # the last three control points
         u = np.arange(1, self.ticks + 1) / self.ticks
         self._basis = _basis(u, dt)
@@ -131,7 +132,7 @@ class ServoStream:
         """
         q = np.asarray(q, dtype=float)
         self._points = np.stack([q, q, q])
-        self._box.reset()
+        self.box.reset()
         self.clipped = 0
 
     def period(self, setpoint: np.ndarray) -> np.ndarray:
@@ -147,17 +148,34 @@ class ServoStream:
         if self._points is None:
             raise ModelError("ServoStream.period before reset: call reset(q0) first")
         last = self._points[-1]
-        lower, upper = self._box.box(last, self.limits.lower, self.limits.upper)
+        lower, upper = self.box.box(last, self.limits.lower, self.limits.upper)
         point = np.clip(setpoint, lower, upper)
         # A set-point outside by no more than the boxes' round-off is kept as it is: the two
         # boxes (the planner's and this one) round alike only while they start alike.
         point = np.where(np.abs(point - setpoint) > ROUND_OFF, point, setpoint)
         if not np.array_equal(point, setpoint):
             self.clipped += 1
-        self._box.record(point - last)
+        self.box.record(point - last)
         control = np.vstack([self._points, point])  # (4, n): this period's control points
         self._points = control[1:]
         return np.einsum("tdk,kn->tdn", self._basis, control)
+
+    def stopping_points(self) -> np.ndarray:
+        """The set-points that bring the arm to rest from where the stream is: every joint
+        braking as hard as its limits let it (rate_limits.braking_path, the braking the
+        planners keep room for), then three periods held where it stopped.
+
+        Returns:
+            The set-points, one per period, shape (periods, n) [rad].
+        """
+        if self._points is None:
+            raise ModelError("ServoStream.stopping_points before reset: call reset(q0) first")
+        before, last, now = self._points
+        box = self.box
+        jerk = np.zeros(0) if box.jerk_change is None else box.jerk_change
+        stops = now + braking_path(now - last, last - before, box.change, jerk)
+        end = stops[-1] if len(stops) else now
+        return np.vstack([stops.reshape(-1, now.size), np.tile(end, (3, 1))])
 
 
 def ticks_per_period(rate: float, dt: float) -> int:
@@ -250,9 +268,10 @@ class ServoTrace:
 def servo_trace(
     setpoints: np.ndarray, q0: np.ndarray, dt: float, stream: ServoStream
 ) -> ServoTrace:
-    """Stream a plan's set-points from rest at q0 until it passes the last one, whose motion
-    goes on meanwhile (where the plan ends, the arm may still be moving: what follows is the
-    next plan's).
+    """Stream a plan's set-points from rest at q0, then bring the arm to rest: past the last
+    set-point every joint brakes as hard as its limits let it (rate_limits.braking_path, the
+    braking the planners keep room for) and the stream holds where it stopped, so that it
+    ends at rest within every limit.
 
     Args:
         setpoints: the set-point commanded at each control period, shape (k, n) [rad].
@@ -261,17 +280,16 @@ def servo_trace(
         stream: the servo stream (reset here).
 
     Returns:
-        The stream: (k + LAG_PERIODS − 1) · ticks samples after the start.
+        The stream: ticks samples per set-point and per braking or holding period after the
+        start.
     """
     q0 = np.asarray(q0, dtype=float)
     stream.reset(q0)
     periods = [stream.period(setpoint) for setpoint in setpoints]
     clipped = stream.clipped
-    # Past the last set-point, its motion goes on until the stream has passed it.
-    motion = setpoints[-1] - (setpoints[-2] if len(setpoints) > 1 else q0)
-    periods += [stream.period(setpoints[-1] + k * motion) for k in range(1, LAG_PERIODS)]
+    periods += [stream.period(point) for point in stream.stopping_points()]
     periods = np.stack(periods)  # (periods, ticks, 3, n)
-    passed = periods[LAG_PERIODS - 1 :, -1, 0]
+    passed = periods[LAG_PERIODS - 1 : LAG_PERIODS - 1 + len(setpoints), -1, 0]
     deviation = np.max(np.abs(passed - setpoints), axis=1)
     start = np.stack([q0, np.zeros_like(q0), np.zeros_like(q0)])[None]
     s = np.concatenate([start, periods.reshape(-1, 3, q0.size)])
