@@ -102,8 +102,9 @@ def test_the_twin_touches_nothing_within_its_effort_limits(twin_runs, scene, met
 
 STALLS = pytest.mark.xfail(
     strict=True,
-    reason="with the jerk limits a servo stream needs, baornn-improved rides self_d_min on the "
-    "book circle: 9.2 mm RMS measured (docs/deviations.md, jerk limits)",
+    reason="with the jerk limits a servo stream needs, baornn-improved reaches the book circle "
+    "with joint 3 at its limit, where the penalty Λ/d holds the tool ~20 mm short beside the "
+    "bracket: 9.2 mm RMS measured (docs/deviations.md, jerk limits)",
 )
 
 

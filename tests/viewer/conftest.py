@@ -50,6 +50,17 @@ def planned_run(tmp_path_factory) -> Path:
     return folder / "run"
 
 
+@pytest.fixture
+def scene_file(tmp_path):
+    """A live scene file: the book's circle beside the rock, its mesh by absolute path."""
+    config = load_toml(CONFIGS / "circle_one_obstacle.toml")
+    for obstacle in config["obstacles"]:
+        obstacle["mesh"] = str(CONFIGS / obstacle["mesh"])
+    path = tmp_path / "scene.toml"
+    path.write_text(tomli_w.dumps(config))
+    return path
+
+
 def free_port() -> int:
     """A TCP port nothing listens on now."""
     with socket.socket() as s:

@@ -29,17 +29,6 @@ from tests.viewer.conftest import (
 
 
 @pytest.fixture
-def scene_file(tmp_path):
-    """The book's circle beside the rock, its mesh by absolute path."""
-    config = load_toml(CONFIGS / "circle_one_obstacle.toml")
-    for obstacle in config["obstacles"]:
-        obstacle["mesh"] = str(CONFIGS / obstacle["mesh"])
-    path = tmp_path / "scene.toml"
-    path.write_text(tomli_w.dumps(config))
-    return path
-
-
-@pytest.fixture
 def server():
     """A viser server on a free port, stopped after the test."""
     s = viser.ViserServer(host="127.0.0.1", port=free_port(), verbose=False)

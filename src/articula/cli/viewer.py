@@ -45,22 +45,38 @@ def live(
         Path | None,
         typer.Option(metavar="FOLDER", help="Write what happened as a run folder `view` replays."),
     ] = None,
+    plant: Annotated[
+        str | None,
+        typer.Option(
+            help="mujoco: drive the MuJoCo twin (the sim extra) and close the loop on its "
+            "measured joints; none: the arm is where it was told (default: the file's [plant])."
+        ),
+    ] = None,
     force: Force = False,
 ) -> None:
     """Run the scene's planner in real time in the browser; drag obstacles and the target.
 
     \b
-    Example: articula live src/articula/book/ch1/configs/circle_two_obstacles.toml --method qp"""
+    Example: articula live src/articula/book/ch1/configs/circle_two_obstacles.toml --method qp
+    With the arm's dynamics: ... --plant mujoco (the measured arm drawn in blue)"""
     from articula.errors import ConfigError
     from articula.runs.folders import check_out
-    from articula.viewer.live import METHODS, run_live
+    from articula.viewer.live import METHODS, PLANTS, run_live
 
     if method is not None and method not in METHODS:
         raise ConfigError(
             "--method", f"unknown method {method!r}; choose one of {', '.join(METHODS)}"
         )
+    if plant is not None and plant not in PLANTS:
+        raise ConfigError("--plant", f"unknown plant {plant!r}; choose one of {', '.join(PLANTS)}")
     if record is not None:
         check_out(record, "run", force, option="--record")
     run_live(
-        scene, method, host, port, record, lambda url: out.print(f"live at {url} (Ctrl-C stops it)")
+        scene,
+        method,
+        host,
+        port,
+        record,
+        lambda url: out.print(f"live at {url} (Ctrl-C stops it)"),
+        plant,
     )

@@ -262,7 +262,7 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
     with fields_as(_CONFIG_PATHS):
         check_reach(plan.scene.robot, plan.targets.positions, p.duration)
         planner = make_planner(p, plan.scene, config.seed)
-        arm = None if config.plant is None else _twin_arm(config, plan)
+        arm = None if config.plant is None else twin_arm(config, plan.scene, plan.q0)
         run = track(
             planner,
             plan.reference,
@@ -308,8 +308,17 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
     )
 
 
-def _twin_arm(config: PlanConfig, plan: PlanSetup) -> Any:
-    """The plan's [plant]: the MuJoCo twin driven by the servo stream (sim.twin_arm)."""
+def twin_arm(config: PlanConfig, scene: Scene, q0: np.ndarray) -> Any:
+    """The config's [plant]: the MuJoCo twin driven by its servo stream (sim.twin_arm).
+
+    Args:
+        config: the validated plan config, with [plant] and [servo].
+        scene: the robot and obstacles the twin is built from.
+        q0: where the arm starts, at rest, shape (n,) [rad].
+
+    Returns:
+        The arm (sim.twin_arm.TwinArm): command (n,) [rad] -> measured joints (n,) [rad].
+    """
     try:  # the `sim` extra: imported only when asked for
         from articula.sim.twin import ServoGains
         from articula.sim.twin_arm import TwinArm
@@ -320,7 +329,7 @@ def _twin_arm(config: PlanConfig, plan: PlanSetup) -> Any:
         ) from None
 
     gains = ServoGains(config.plant.stiffness, config.plant.damping)
-    return TwinArm(plan.scene, plan.q0, config.planner.dt, config.servo.rate, gains)
+    return TwinArm(scene, q0, config.planner.dt, config.servo.rate, gains)
 
 
 def load_plan(path: Path, servo_rate: float | None = None) -> dict[str, Any]:

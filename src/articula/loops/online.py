@@ -54,6 +54,22 @@ class LivePose:
         return self.pose
 
 
+def with_live_obstacles(scene: Scene) -> tuple[Scene, dict[str, LivePose]]:
+    """The scene with every obstacle at a pose a live loop sets (starting where it is at t = 0).
+
+    Args:
+        scene: the robot and its obstacles.
+
+    Returns:
+        The scene with live obstacles, and obstacle name -> its LivePose.
+    """
+    live = {o.name: LivePose(o.pose_at(0.0)) for o in scene.obstacles}
+    obstacles = [Obstacle(o.name, o.parts, live[o.name]) for o in scene.obstacles]
+    robot, pairs = scene.robot, scene.self_pair_names
+    moved = Scene(robot, obstacles, scene.broadphase, scene.metric, pairs, scene.self_d_min)
+    return moved, live
+
+
 class OnlineController:
     """A planner one control period at a time, from a start it checks.
 
@@ -106,18 +122,7 @@ class OnlineController:
         """
         live: dict[str, LivePose] = {}
         if live_obstacles:
-            obstacles = []
-            for o in scene.obstacles:
-                live[o.name] = LivePose(o.pose_at(0.0))
-                obstacles.append(Obstacle(o.name, o.parts, live[o.name]))
-            scene = Scene(
-                scene.robot,
-                obstacles,
-                scene.broadphase,
-                scene.metric,
-                scene.self_pair_names,
-                scene.self_d_min,
-            )
+            scene, live = with_live_obstacles(scene)
         return cls(make_planner(spec, scene, seed), spec.dt, live)
 
     def reset(

@@ -83,13 +83,21 @@ class TwinArm:
         columns |= {f"tau_{j + 1}": torque[:, j] for j in range(torque.shape[1])}
         return columns | {"contacts": np.array(self.contacts, dtype=float)}
 
-    def metrics(self, run: PlanResult, scene: Scene, settle: float) -> dict[str, float]:
+    def metrics(
+        self,
+        run: PlanResult,
+        scene: Scene,
+        settle: float,
+        clearance: np.ndarray | None = None,
+    ) -> dict[str, float]:
         """What the twin did, against the run's reference.
 
         Args:
             run: the tracking run (its reference and times).
             scene: the scene, for the measured clearance and tool.
             settle: time after the path's start from which the run counts as settled [s].
+            clearance: the measured arm's clearance each period, where the obstacles were
+                then [m]; None: found here from the scene's obstacle motion.
 
         Returns:
             plant_rms_error (the measured tool against the reference once settled [m]),
@@ -100,7 +108,9 @@ class TwinArm:
         tool = np.array([robot.ee_position(q) for q in self.measured])
         settled = run.t >= run.path_start + settle
         error = np.linalg.norm(tool - run.x_ref, axis=1)[settled]
-        clearance = [scene.clearances(q, t)[0] for q, t in zip(self.measured, run.t, strict=True)]
+        if clearance is None:
+            pairs = zip(self.measured, run.t, strict=True)
+            clearance = np.array([scene.clearances(q, t)[0] for q, t in pairs])
         return {
             "plant_rms_error": float(np.sqrt(np.mean(error**2))) if error.size else 0.0,
             "plant_min_clearance": float(np.min(clearance)),

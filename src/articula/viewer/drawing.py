@@ -63,13 +63,20 @@ def clearance_colour(d: float, d_min: float) -> tuple[int, int, int]:
 
 
 def add_robot(
-    server: viser.ViserServer, visuals: dict[str, list[Visual]]
+    server: viser.ViserServer,
+    visuals: dict[str, list[Visual]],
+    root: str = "/robot",
+    colour: tuple[int, int, int] = ROBOT_COLOUR,
+    opacity: float | None = None,
 ) -> tuple[dict[str, viser.FrameHandle], dict[str, list]]:
-    """A frame per link (/robot/<link>) with its meshes; (frames, meshes) by link name.
+    """A frame per link (<root>/<link>) with its meshes; (frames, meshes) by link name.
 
     Args:
         server: the viser server to draw in.
         visuals: link name -> its meshes and their poses in the link frame.
+        root: the scene node the arm is drawn under (a second arm needs its own).
+        colour: the meshes' colour (RGB, 0-255).
+        opacity: the meshes' opacity, 0-1; None: opaque.
 
     Returns:
         The link frames (posed to move the link) and each link's mesh handles (recoloured
@@ -77,16 +84,17 @@ def add_robot(
     """
     frames, meshes = {}, {}
     for link, items in visuals.items():
-        frames[link] = server.scene.add_frame(f"/robot/{link}", show_axes=False)
+        frames[link] = server.scene.add_frame(f"{root}/{link}", show_axes=False)
         meshes[link] = []
         for i, visual in enumerate(items):
             wxyz, position = wxyz_position(visual.placement)
             meshes[link].append(
                 server.scene.add_mesh_simple(
-                    f"/robot/{link}/visual_{i}",
+                    f"{root}/{link}/visual_{i}",
                     np.asarray(visual.mesh.vertices, dtype=np.float32),
                     np.asarray(visual.mesh.faces, dtype=np.uint32),
-                    color=ROBOT_COLOUR,
+                    color=colour,
+                    opacity=opacity,
                     wxyz=wxyz,
                     position=position,
                 )

@@ -5,13 +5,15 @@ Every control period reads each obstacle's drag gizmo, steps the same OnlineCont
 that moves it on the page (viewer/painter.py: the loop never waits on the browser). The
 end-effector target follows the scene's trajectory or a gizmo of its own; the method, Λ and
 d_min can be changed from the panel (the controller is rebuilt from the arm's current
-configuration).
+configuration). With a plant (`--plant mujoco`, viewer/live_plant.py) the commands drive the
+MuJoCo twin, the controller closes its loop on the joints it measures, and the measured arm is
+drawn beside the commanded one.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -19,50 +21,28 @@ import numpy as np
 import viser
 
 from articula.errors import ArticulaError
-from articula.experiments.plan import NAME as PLAN
-from articula.experiments.plan import build_plan
+from articula.experiments.plan import PlanConfig, build_plan
 from articula.loops.online import OnlineController
-from articula.loops.tracking import PlanResult, trace_columns, tracking_metrics
 from articula.planning.approach import Approach
 from articula.planning.config import (
     METHODS,
     PlannerSpec,
     absolute_paths,
 )
-from articula.runs.records import build_record, write_run
-from articula.runs.registry import Result
 from articula.scene.scene import Scene
 from articula.validation import load_toml
 from articula.viewer import drawing
+from articula.viewer.live_plant import COMMANDED_OPACITY, LivePlant
+from articula.viewer.live_record import Recording
 from articula.viewer.painter import Painter
-from articula.viewer.run_data import TRACK, visuals_of
+from articula.viewer.run_data import visuals_of
 
 READOUT_EVERY = 9  # periods between readouts (~10 a second, what a person reads); a
 # multiple of DRAW_EVERY, as a readout goes out with a picture
 DRAW_EVERY = 3  # periods between pictures: 33 Hz at 10 ms, smooth to the eye (each is
 # pushed to the page by the painter's thread, viewer/painter.py: the loop never waits on it)
-
-
-@dataclass
-class Recording:
-    """What happened, period by period: times [s], configurations [rad], end-effector and
-    target positions [m], clearance [m], obstacle poses (name -> [x, y, z, qw, qx, qy, qz]).
-
-    Attributes:
-        t: each period's planner time [s].
-        q: each period's joint positions, shape (n,) each [rad].
-        x: each period's end-effector position, shape (3,) each [m].
-        x_ref: each period's target position, shape (3,) each [m].
-        clearance: each period's smallest clearance [m] (inf without obstacles).
-        obstacles: obstacle name -> its pose each period, [x, y, z (m), qw, qx, qy, qz].
-    """
-
-    t: list[float] = field(default_factory=list)
-    q: list[np.ndarray] = field(default_factory=list)
-    x: list[np.ndarray] = field(default_factory=list)
-    x_ref: list[np.ndarray] = field(default_factory=list)
-    clearance: list[float] = field(default_factory=list)
-    obstacles: dict[str, list[np.ndarray]] = field(default_factory=dict)
+PLANTS = ("mujoco", "none")  # `live --plant`
+DEFAULT_SERVO_RATE = 1000.0  # [Hz] the twin's servo rate where the scene file has no [servo]
 
 
 @dataclass
@@ -76,21 +56,27 @@ class LiveScene:
         q0: the start configuration, shape (n,) [rad].
         targets: the end-effector's reference (t [s] -> target): the approach from the tool
             to the path's start, then the path.
+        validated: the plan config as validated ([plant] and [servo] included).
     """
 
     config: dict[str, Any]
     scene: Scene
     q0: np.ndarray
     targets: Approach
+    validated: PlanConfig
 
     @classmethod
-    def load(cls, scene_file: Path, method: str | None = None) -> LiveScene:
+    def load(
+        cls, scene_file: Path, method: str | None = None, plant: str | None = None
+    ) -> LiveScene:
         """Read scene_file; an ArticulaError (before any server opens) when its planner does
         not validate or cannot start from its q0.
 
         Args:
             scene_file: a scene TOML with [planner] and [trajectory] tables.
             method: the planner method to use instead of the file's; None: the file's.
+            plant: "mujoco" (the dynamics twin, at the file's [servo] rate or 1 kHz) or "none"
+                (the arm is where it was told) instead of the file's [plant]; None: the file's.
 
         Returns:
             The scene file, read and checked.
@@ -98,9 +84,15 @@ class LiveScene:
         config = _plan_config(scene_file)
         if method is not None:
             config["planner"]["method"] = method
+        if plant == "none":
+            config.pop("plant", None)
+        elif plant is not None:
+            config["plant"] = {**config.get("plant", {}), "type": plant}
+            config.setdefault("servo", {"rate": DEFAULT_SERVO_RATE})
         plan = build_plan(config, scene_file.parent, str(scene_file))  # named as `plan` does
         plan.controller(live_obstacles=True)  # a start it refuses is refused here
-        return cls(config, plan.scene, plan.q0, plan.reference)
+        config["planner"]["limits"] = plan.spec.limits  # a stream's jerk limits, as `plan`'s
+        return cls(config, plan.scene, plan.q0, plan.reference, plan.config)
 
 
 class Live:
@@ -130,9 +122,9 @@ class Live:
             handle.on_update(lambda _: self.rebuild())
         server.scene.add_grid("/grid", width=2.0, height=2.0, cell_size=0.1)
         drawing.aim_camera(server)
-        self.frames, self.meshes = drawing.add_robot(
-            server, visuals_of(self.config["robot"], self.scene)
-        )
+        visuals = visuals_of(self.config["robot"], self.scene)
+        ghost = None if loaded.validated.plant is None else COMMANDED_OPACITY
+        self.frames, self.meshes = drawing.add_robot(server, visuals, opacity=ghost)
         self.gizmos = {}
         for obstacle in self.scene.obstacles:
             wxyz, position = drawing.wxyz_position(obstacle.pose_at(0.0))
@@ -148,9 +140,11 @@ class Live:
         self.colours: dict[str, tuple[int, int, int]] = {}  # as painted (painter's thread)
         self.painter = Painter(server)
         self.periods = 0
-        self.step_ms: list[float] = []
         self.controller: OnlineController | None = None
         self.q = self.q0.copy()
+        self.plant = None
+        if loaded.validated.plant is not None:
+            self.plant = LivePlant(server, loaded.validated, self.scene, self.q0, visuals)
         self.rebuild()
 
     @property
@@ -212,11 +206,15 @@ class Live:
         else:
             target = np.asarray(self.target.position, dtype=float)
         poses = self._gizmo_poses()
+        measured = None if self.plant is None else self.plant.q
         start = time.perf_counter()
-        self.q = controller.step(target, poses)
+        self.q = controller.step(target, poses, q_measured=measured)
         elapsed = time.perf_counter() - start
+        if self.plant is not None:
+            self.plant(self.q, poses)
+            self.recording.measured_clearance.append(self.plant.clearance())
         self.periods += 1
-        self.step_ms.append(1e3 * elapsed)
+        self.recording.step_ms.append(1e3 * elapsed)
         self._show(t, target, poses, elapsed)
         return elapsed
 
@@ -238,15 +236,7 @@ class Live:
             self._draw(d, x, target, clearance, elapsed)
         else:
             clearance = scene.clearances(self.q, t)[0] if scene.obstacles else np.inf
-        r = self.recording
-        r.t.append(t)
-        r.q.append(self.q.copy())
-        r.x.append(x)
-        r.x_ref.append(np.asarray(target, dtype=float).copy())
-        r.clearance.append(clearance)
-        for name, T in poses.items():
-            wxyz, position = drawing.wxyz_position(T)
-            r.obstacles.setdefault(name, []).append(np.r_[position, wxyz])
+        self.recording.add(t, self.q, x, target, clearance, poses)
 
     def _draw(
         self, d: np.ndarray, x: np.ndarray, target: np.ndarray, clearance: float, elapsed: float
@@ -263,16 +253,27 @@ class Live:
             link.name: drawing.clearance_colour(float(d[i].min()), d_min)
             for i, link in enumerate(scene.robot.links)
         }
+        if self.plant is not None:
+            frames |= {f"measured {name}": pose for name, pose in self.plant.link_frames().items()}
         readout = None
         if late or self.periods % READOUT_EVERY == 0:
-            error = float(np.linalg.norm(x - target))
-            readout = (
-                f"clearance **{1e3 * clearance:.1f} mm** · error {1e3 * error:.2f} mm"
-                f" · planner {1e3 * elapsed:.2f} ms per {1e3 * self.dt:.0f} ms period"
-                + (" · **over the period**" if late else "")
-            )
+            readout = self._readout(x, target, clearance, elapsed)
         shown = target.copy() if self.follow.value else None
         self.painter.post(lambda: self._paint(frames, colours, readout, shown))
+
+    def _readout(self, x: np.ndarray, target: np.ndarray, clearance: float, elapsed: float) -> str:
+        """The panel's line: clearance, error, the planner's time (and the measured arm's)."""
+        error = float(np.linalg.norm(x - target))
+        readout = f"clearance **{1e3 * clearance:.1f} mm** · error {1e3 * error:.2f} mm"
+        if self.plant is not None:
+            tool = self.scene.robot.ee_position(self.plant.q)
+            readout += (
+                f" · measured: error {1e3 * float(np.linalg.norm(tool - target)):.2f} mm,"
+                f" clearance {1e3 * self.recording.measured_clearance[-1]:.1f} mm,"
+                f" contacts {self.plant.arm.contacts[-1]}"
+            )
+        readout += f" · planner {1e3 * elapsed:.2f} ms per {1e3 * self.dt:.0f} ms period"
+        return readout + (" · **over the period**" if elapsed > self.dt else "")
 
     def _paint(
         self,
@@ -286,7 +287,11 @@ class Live:
         if target is not None:
             self.target.position = target
         for name, (wxyz, position) in frames.items():
-            self.frames[name].wxyz, self.frames[name].position = wxyz, position
+            if name in self.frames:
+                frame = self.frames[name]
+            else:  # the measured arm's
+                frame = self.plant.frames[name.removeprefix("measured ")]
+            frame.wxyz, frame.position = wxyz, position
         for name, colour in colours.items():
             if self.colours.get(name) != colour:  # only what changed goes out
                 self.colours[name] = colour
@@ -318,32 +323,11 @@ class Live:
         Returns:
             The run's record (record.json).
         """
-        r = self.recording
-        if not r.t:
-            raise ArticulaError("--record: nothing happened yet (no control period ran)")
-        x, x_ref = np.array(r.x), np.array(r.x_ref)
-        run = PlanResult(
-            np.array(r.t),
-            np.array(r.q),
-            x,
-            x_ref,
-            np.linalg.norm(x - x_ref, axis=1),
-            np.array(r.clearance),
-            1e-3 * float(np.sum(self.step_ms[1:])),
-            1e-3 * self.step_ms[0],
-            self.q0,
-        )
         iterations = float(self.controller.planner.iterations) if self.controller else 0.0
-        metrics = tracking_metrics(run, self.scene.robot, 0.0, iterations)
-        metrics["overrun_fraction"] = float(np.mean(np.array(self.step_ms) > 1e3 * self.dt))
-        trace = trace_columns(run)
-        for name, rows in r.obstacles.items():
-            for c, column in zip(TRACK, np.array(rows).T, strict=True):
-                trace[f"obstacle_{name}_{c}"] = column
-        config = {**self.config, "experiment": PLAN}
-        record = build_record(config, Result(metrics, {}), wall_time)
-        write_run(folder, config, record, trace)
-        return record
+        plant = None if self.plant is None else self.plant.arm
+        return self.recording.write(
+            folder, self.config, self.scene, self.q0, self.dt, iterations, plant, wall_time
+        )
 
 
 def _plan_config(scene_file: Path) -> dict[str, Any]:
@@ -356,7 +340,13 @@ def _plan_config(scene_file: Path) -> dict[str, Any]:
 
 
 def run_live(
-    scene_file: Path, method: str | None, host: str, port: int, record: Path | None, announce
+    scene_file: Path,
+    method: str | None,
+    host: str,
+    port: int,
+    record: Path | None,
+    announce,
+    plant: str | None = None,
 ) -> None:
     """Serve the live page until Ctrl-C, a period every dt; then write --record if asked.
 
@@ -367,10 +357,11 @@ def run_live(
         port: the TCP port to listen on.
         record: the run folder to write the session to at the end; None: none.
         announce: called as announce(url) once the page is served.
+        plant: "mujoco" or "none" instead of the file's [plant]; None: the file's.
     """
     from articula.viewer.replay import open_server, stop_server
 
-    loaded = LiveScene.load(scene_file, method)  # a bad file fails before the port opens
+    loaded = LiveScene.load(scene_file, method, plant)  # a bad file fails before the port opens
     server = open_server(host, port)
     started = time.monotonic()
     live = None

@@ -1,0 +1,79 @@
+"""`articula live --plant mujoco`: the page's commands drive the MuJoCo twin through the servo
+stream, the controller closes its loop on the measured joints, the measured arm is drawn where
+the twin has it (and its obstacles where the page's gizmos put them), --record keeps the twin's
+columns and metrics, and the page renders in Chromium."""
+
+from __future__ import annotations
+
+import signal
+
+import numpy as np
+import pytest
+import viser
+
+from articula.viewer.drawing import wxyz_position
+from articula.viewer.live import Live, LiveScene
+from articula.viewer.run_data import load_run
+from tests.viewer.conftest import free_port, keep_screenshot, open_page, screenshot
+
+mujoco = pytest.importorskip(
+    "mujoco", reason='the twin needs the `sim` extra: pip install -e ".[sim]"'
+)
+
+
+@pytest.fixture
+def server():
+    """A viser server on a free port, stopped after the test."""
+    s = viser.ViserServer(host="127.0.0.1", port=free_port(), verbose=False)
+    yield s
+    s.stop()
+
+
+def test_the_measured_arm_follows_the_commands_and_is_drawn_where_the_twin_has_it(
+    server,
+    scene_file,
+    tmp_path,
+):
+    live = Live(server, LiveScene.load(scene_file, "qp", plant="mujoco"))
+    assert live.spec().limits == "velocity+acceleration+jerk"  # a stream's, as plan's
+    rock = live.gizmos["rock"]
+    for k in range(150):
+        if k == 100:  # the rock dragged 5 cm up: the twin's copy goes with it
+            rock.position = np.add(rock.position, [0.0, 0.0, 0.05])
+        live.period()
+    twin = live.plant.arm.twin
+    mocap = twin.model.body("moving_0").mocapid[0]
+    np.testing.assert_allclose(twin.data.mocap_pos[mocap], rock.position, atol=1e-9)
+    commanded, measured = np.array(live.recording.q), np.array(live.plant.arm.measured)
+    assert len(measured) == 150
+    assert np.max(np.abs(commanded - measured)[50:]) < 0.02  # the servo follows within 20 mrad
+    assert not any(live.plant.arm.contacts) and min(live.recording.measured_clearance) > 0
+    assert live.painter.flush()
+    assert "measured: error" in live.readout.content
+    poses = live.scene.robot.link_poses(live.plant.q)
+    for name, frame in live.plant.frames.items():
+        if name in poses:
+            np.testing.assert_allclose(frame.position, wxyz_position(poses[name])[1], atol=1e-6)
+    live.close()
+    record = live.write(tmp_path / "rec", 1.0)
+    assert record["metrics"]["plant_contacts"] == 0
+    assert record["metrics"]["plant_min_clearance"] == min(live.recording.measured_clearance)
+    assert 0 < record["metrics"]["max_torque_ratio"] <= 1
+    assert len(load_run(tmp_path / "rec").t) == 150
+
+
+def test_an_unknown_plant_is_one_line_and_exit_2(scene_file, cli):
+    proc = cli("live", scene_file, "--plant", "gazebo", "--port", str(free_port()))
+    assert proc.returncode == 2
+    assert len(proc.stderr.strip().splitlines()) == 1 and "--plant" in proc.stderr
+
+
+def test_the_live_page_shows_the_measured_arm(scene_file, viewer, browser, tmp_path):
+    proc, url = viewer("live", scene_file, "--method", "qp", "--plant", "mujoco")
+    page = open_page(browser, url, wait_for="measured: error")
+    view = screenshot(page)[:, 40:900]  # the 3-D view, as robot_mask takes it
+    keep_screenshot(page, "live_plant.png", tmp_path)
+    r, g, b = view[..., 0], view[..., 1], view[..., 2]
+    assert np.sum((b > 120) & (b > 1.3 * r) & (b > 1.1 * g)) > 2000  # the measured arm's blue
+    proc.send_signal(signal.SIGINT)
+    assert proc.wait(30) == 0
