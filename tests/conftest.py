@@ -8,7 +8,7 @@ import shutil
 import signal
 import subprocess
 import sys
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -145,3 +145,27 @@ def main_fails(capsys) -> Callable[..., str]:
         return lines[0]
 
     return run
+
+
+@pytest.fixture
+def emulate_process() -> Iterator[Callable[..., tuple[subprocess.Popen, str]]]:
+    """emulate_process(rig, *args): `articula emulate RIG <args>` as a process, and the device
+    path of its first line; every process is stopped (SIGTERM, then SIGKILL) after."""
+    started: list[subprocess.Popen] = []
+
+    def run(rig: str, *args: object) -> tuple[subprocess.Popen, str]:
+        proc = subprocess.Popen([ARTICULA, "emulate", rig, *map(str, args)],
+                                stdout=subprocess.PIPE, text=True)  # fmt: skip
+        started.append(proc)
+        line = proc.stdout.readline()  # "RIG rig at /dev/pts/N (Ctrl-C stops it)"
+        assert " rig at " in line, f"emulate printed {line!r}, exit {proc.poll()}"
+        return proc, line.split()[3]
+
+    yield run
+    for proc in started:
+        proc.terminate()
+        try:
+            proc.wait(10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait(10)

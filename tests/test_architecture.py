@@ -31,6 +31,7 @@ LAYERS = {
     "runs": 9,
     "sim": 9,
     "rigs": 10,
+    "identify": 10,
     "experiments": 11,
     "book": 12,
     "bench": 12,

@@ -21,7 +21,8 @@
  * its latency: the longest from a marked interrupt's entry to its reti, nested ones
  * included) and waits
  * for "<adc code> <encoder count> [<hex bytes>]": the code the conversion reads, the count
- * the quadrature encoder on D2/D3 (PE4/PE5) reaches, one edge every EDGE_CYCLES, and bytes a
+ * the quadrature encoder on D2/D3 (PE4/PE5) reaches, its edges spread over EDGE_SPAN_CYCLES
+ * (EDGE_CYCLES apart at the closest), and bytes a
  * sensor sends on Serial1 (RX1, at 115 200 baud). With --tick-us the plant has its own step
  * instead: an exchange every N µs of a run (adc channel 255), from N µs after its start. A
  * run starting (the firmware's probe, probe.h) is "run <seed>"; its end "end".
@@ -60,7 +61,11 @@
 #define PROBE_BUSY 2
 #define PROBE_IDLE 3
 #define PROBE_END 4
-#define EDGE_CYCLES 64          /* between the encoder's edges */
+#define EDGE_CYCLES 64          /* between the encoder's edges, at the closest */
+#define EDGE_SPAN_CYCLES 1280   /* a period's edges spread over this, within the conversion's
+                                 * 1664 cycles (13 ADC clocks at /128), as a turning shaft spaces
+                                 * them: bunched 64 cycles apart, an edge came before the last
+                                 * one's interrupt read the pins once an interrupt was late */
 #define SENSOR_BYTE_CYCLES 1389 /* at 115 200 baud */
 #define NO_CONVERSION 255
 #define SENSOR_QUEUE 65536
@@ -82,6 +87,7 @@ static uint8_t seed_bytes;
 static avr_irq_t *sensor_in, *adc_in, *encoder_pin[2];
 static avr_cycle_count_t tick_cycles; /* the plant's own step (--tick-us); 0: per conversion */
 static int32_t encoder_count, encoder_target;
+static avr_cycle_count_t edge_cycles = EDGE_CYCLES; /* between this period's edges */
 static uint8_t encoder_phase; /* the pins' state in the Gray sequence 00, 10, 11, 01 */
 static struct {
     uint8_t data[SENSOR_QUEUE];
@@ -138,7 +144,7 @@ static avr_cycle_count_t encoder_edge(avr_t *a, avr_cycle_count_t when, void *pa
     static const uint8_t pins[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
     avr_raise_irq(encoder_pin[0], pins[encoder_phase][0]);
     avr_raise_irq(encoder_pin[1], pins[encoder_phase][1]);
-    return encoder_count == encoder_target ? 0 : when + EDGE_CYCLES;
+    return encoder_count == encoder_target ? 0 : when + edge_cycles;
 }
 
 static uint16_t reg16(uint16_t low) { return (uint16_t)(avr->data[low] | (avr->data[low + 1] << 8)); }
@@ -173,6 +179,9 @@ static void exchange(unsigned channel) {
         avr_raise_irq(adc_in + channel, mv);
     }
     encoder_target = (int32_t)count;
+    long edges = labs((long)encoder_target - (long)encoder_count);
+    edge_cycles = edges > 1 && EDGE_SPAN_CYCLES / edges > EDGE_CYCLES ? EDGE_SPAN_CYCLES / edges
+                                                                       : EDGE_CYCLES;
     avr_cycle_timer_cancel(avr, encoder_edge, NULL);
     if (encoder_target != encoder_count) avr_cycle_timer_register(avr, 1, encoder_edge, NULL);
     unsigned byte;

@@ -10,7 +10,6 @@ from pathlib import Path
 import pytest
 
 from articula.rigs.firmware import FirmwareRig, PinPlant
-from tests.conftest import ARTICULA
 
 FIRMWARE = Path(__file__).resolve().parents[2] / "firmware"
 TOOLCHAIN = "apt-get install -y gcc-avr avr-libc simavr libsimavr-dev"
@@ -66,25 +65,12 @@ def on_plant(built) -> Iterator[Callable[[str, PinPlant], FirmwareRig]]:
 
 
 @pytest.fixture
-def emulated(built) -> Iterator[Callable[[str], tuple[subprocess.Popen, str]]]:
-    """emulated(rig): `articula emulate RIG --firmware build/<rig>.elf` as a process, and the
-    device path of its first line; every process is stopped (SIGTERM, then SIGKILL) after."""
-    started: list[subprocess.Popen] = []
+def emulated(built, emulate_process) -> Callable[..., tuple[subprocess.Popen, str]]:
+    """emulated(rig, *args): `articula emulate RIG --firmware build/<rig>.elf <args>` as a
+    process (tests/conftest.py's emulate_process), and the device path of its first line."""
 
-    def run(rig: str) -> tuple[subprocess.Popen, str]:
+    def run(rig: str, *args: object) -> tuple[subprocess.Popen, str]:
         elf = built / f"{rig.replace('-', '_')}.elf"
-        proc = subprocess.Popen([ARTICULA, "emulate", rig, "--firmware", elf],
-                                stdout=subprocess.PIPE, text=True)  # fmt: skip
-        started.append(proc)
-        line = proc.stdout.readline()  # "RIG rig at /dev/pts/N (Ctrl-C stops it)"
-        assert " rig at " in line, f"emulate printed {line!r}, exit {proc.poll()}"
-        return proc, line.split()[3]
+        return emulate_process(rig, "--firmware", elf, *args)
 
-    yield run
-    for proc in started:
-        proc.terminate()
-        try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait(10)
+    return run

@@ -22,7 +22,7 @@ from typing import Literal
 
 from articula.errors import ConfigError, ResourceError
 
-Kind = Literal["run", "sweep", "report", "suite"]
+Kind = Literal["run", "sweep", "report", "suite", "identification"]
 CONFIG = "config.toml"
 RECORD = "record.json"
 TRACE = "trace.parquet"
@@ -32,6 +32,9 @@ SUMMARY = "summary.json"
 SUITE_FILES = frozenset({RESULTS, SUMMARY})  # and the problems/ folder
 JOURNAL = "telemetry.csv"  # a rig run's samples as they arrived (rigs/recorder.py)
 TUNING = "tuning.json"  # a rig tuning's result (articula rig tune)
+IDENTIFICATION = "identification.json"  # a fit's constants (articula identify)
+IDENTIFICATION_FILES = frozenset({IDENTIFICATION, "plant.toml", "fit.png"})
+EXCITATION = re.compile(r"^excitation_\d+$")  # a rig identification's recordings, run folders
 SERVO = "servo.parquet"  # a plan's servo stream (articula plan --servo-rate)
 TABLES = frozenset({SERVO})  # the further tables a run may write beside trace.parquet
 RUN_FILES = frozenset({CONFIG, RECORD, TRACE, JOURNAL, TUNING}) | TABLES
@@ -58,7 +61,8 @@ def foreign_entries(folder: Path, kind: Kind) -> list[str]:
 
     Args:
         folder: an existing output folder.
-        kind: what articula writes there: "run", "sweep", "report" or "suite".
+        kind: what articula writes there: "run", "sweep", "report", "suite" or
+            "identification".
 
     Returns:
         The foreign entry names, sorted; empty when everything in it is articula's.
@@ -72,6 +76,12 @@ def foreign_entries(folder: Path, kind: Kind) -> list[str]:
         elif kind == "sweep":
             ours = (name == RESULTS and not path.is_dir()) or (
                 RUN_FOLDER.match(entry) is not None
+                and path.is_dir()
+                and not foreign_entries(path, "run")
+            )
+        elif kind == "identification":
+            ours = (name in IDENTIFICATION_FILES and not path.is_dir()) or (
+                EXCITATION.match(entry) is not None
                 and path.is_dir()
                 and not foreign_entries(path, "run")
             )
@@ -94,7 +104,8 @@ def check_out(folder: Path, kind: Kind, force: bool = False, option: str = "--ou
 
     Args:
         folder: the output folder.
-        kind: what articula writes there: "run", "sweep", "report" or "suite".
+        kind: what articula writes there: "run", "sweep", "report", "suite" or
+            "identification".
         force: accept a folder holding files articula did not write.
         option: the command-line option that named the folder, for the message.
     """
@@ -131,7 +142,8 @@ def claimed(folder: Path, kind: Kind, force: bool = False) -> Iterator[Path]:
 
     Args:
         folder: the output folder (--out).
-        kind: what articula writes there: "run", "sweep", "report" or "suite".
+        kind: what articula writes there: "run", "sweep", "report", "suite" or
+            "identification".
         force: accept a folder holding files articula did not write.
 
     Yields:
@@ -158,9 +170,16 @@ def remove_stale_temporaries(folder: Path, kind: Kind) -> None:
 
     Args:
         folder: the output folder, locked by this process.
-        kind: what articula writes there: "run", "sweep", "report" or "suite".
+        kind: what articula writes there: "run", "sweep", "report", "suite" or
+            "identification".
     """
-    own = {"run": RUN_FILES, "sweep": {RESULTS}, "report": {REPORT}, "suite": SUITE_FILES}[kind]
+    own = {
+        "run": RUN_FILES,
+        "sweep": {RESULTS},
+        "report": {REPORT},
+        "suite": SUITE_FILES,
+        "identification": IDENTIFICATION_FILES,
+    }[kind]
     for entry in os.listdir(folder):
         if temporary_name_of(entry) in own:
             (folder / entry).unlink(missing_ok=True)
