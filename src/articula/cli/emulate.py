@@ -30,7 +30,8 @@ def emulate(
         Path | None,
         typer.Option(
             help="motor: a motor.current config whose rig, motor, dt, PWM, sensor and "
-            "encoder the emulated rig has (default: chapter 4's)."
+            "encoder the emulated rig has; pneunet: a pneunet.pid config whose [plant] it "
+            "has (default: the book's; `articula identify` writes one as plant.toml)."
         ),
     ] = None,
     firmware: Annotated[

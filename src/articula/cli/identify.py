@@ -22,7 +22,7 @@ Window = Annotated[
 
 @app.command()
 def identify(
-    rig: Annotated[str, typer.Argument(help="The rig whose model to fit: motor.")],
+    rig: Annotated[str, typer.Argument(help="The rig whose model to fit: motor or pneunet.")],
     recordings: Annotated[
         list[Path], typer.Argument(help="Run folders of the rig (rig record / run / identify).")
     ],
@@ -46,25 +46,25 @@ def identify(
 def rig_identify(
     port: Port,
     out_dir: OutDir,
-    rig: Annotated[str, typer.Option(help="The rig on the port: motor.")] = "motor",
     seed: Annotated[int, typer.Option(min=0, help="Noise seed of an emulated rig.")] = 0,
     encoder_window: Window = 50,
     force: Force = False,
     as_json: JsonFlag = False,
 ) -> None:
-    """Run an excitation designed for identification on the rig, record it, fit its model.
+    """Run an excitation designed for identification on the rig (motor or PneuNet, as it
+    reports), record it, fit its model.
 
     Each part of the excitation is a run folder out/excitation_<k>; its amplitudes are in
     identification.json.
 
     \b
     Example: articula rig identify /dev/ttyACM0 --out runs/ident"""
-    from articula.experiments.rig_identify import MOTOR_EXCITATION, identify_on_rig
+    from articula.experiments.rig_identify import identify_on_rig
 
     with progress_bar(as_json) as bar:
-        task = bar.add_task("excitation on the rig", total=len(MOTOR_EXCITATION))
+        task = bar.add_task("excitation on the rig: parts", total=None)
         summary = identify_on_rig(
-            port, rig, out_dir, seed, encoder_window, force, lambda: bar.advance(task)
+            port, out_dir, seed, encoder_window, force, lambda: bar.advance(task)
         )
     _show(summary, out_dir, as_json)
 

@@ -8,11 +8,14 @@ sensor's angle: a rig has no other.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from articula.control.pid import GainSchedule
 from articula.errors import ConfigError
 from articula.experiments.pneunet import AngleReference, PneuNetPidConfig
+from articula.plants.pneunet import PneuNetParams
 from articula.rigs.link import Link
 from articula.rigs.pneunet import encode_gains
 from articula.rigs.programs import Program, Shape, steps
@@ -20,6 +23,7 @@ from articula.rigs.protocol import Info, Kind
 from articula.rigs.recorder import Recorder
 from articula.rigs.run import run_program
 from articula.tuning.response import tracking_error, tuning_cost
+from articula.validation import load_toml, parse_model
 
 CHANNELS = ("trial", "theta_ref_deg", "theta_meas_deg", "pwm")  # the recorder's columns
 
@@ -34,6 +38,22 @@ def channels(info: Info) -> tuple[str, ...]:
         The trial, reference, measured angle and PWM columns.
     """
     return CHANNELS
+
+
+def plant_config(path: Path | None) -> PneuNetParams:
+    """The PneuNet an emulated rig has: the [plant] table of a pneunet.pid config (what
+    `articula identify pneunet` writes as plant.toml).
+
+    Args:
+        path: A pneunet.pid config file (its `experiment` key is optional); None: the
+            chapter's defaults.
+
+    Returns:
+        The actuator's constants (ConfigError naming the file and key where they do not read).
+    """
+    data = {} if path is None else load_toml(path)
+    data.pop("experiment", None)
+    return parse_model(PneuNetPidConfig, data, str(path or "defaults")).plant
 
 
 def reference_program(reference: AngleReference, duration: float) -> Program:

@@ -1,16 +1,21 @@
-"""`articula rig identify`: an excitation designed for identification run on the rig, each part
-recorded as a run folder, then fitted (identify/).
+"""`articula rig identify`: an excitation designed for identification run on the rig on the
+port (whichever it reports), each part recorded as a run folder, then fitted (identify/).
 
 The motor's excitation is three current programs the rig's own loop tracks, within its safe
-amplitudes (SAFE_CURRENT): a constant current with a slow sinusoid that spins the shaft up
+amplitudes (SAFE_CURRENT): a constant current with a 2 Hz sinusoid that spins the shaft up
 until the driver's voltage saturates (K and b, from the speed the back-emf allows), a slow
 sinusoid about zero (J, from the speed swing) and a fast one (L and R, from the current's
-response). The speed loop's gains are 0, so a load motor on the shaft is never driven.
+response); the speed loop's gains are 0, so a load motor on the shaft is never driven. The
+PneuNet's is four open-loop steps of the valve's PWM count from rest (SET_OUTPUT), at most
+SAFE_PWM: the angles they settle at give the pressure-to-angle map, their rise the chamber's
+lag and the bending's frequency and damping.
 """
 
 from __future__ import annotations
 
 import math
+import struct
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -19,14 +24,18 @@ from articula.experiments.motor import CurrentControlConfig, CurrentReference
 from articula.experiments.motor_on_rig import channels, run_on_rig
 from articula.identify.folders import DEFAULT_WINDOW, fit_and_write
 from articula.rigs.link import Link
-from articula.rigs.protocol import RigKind
+from articula.rigs.protocol import Kind, RigKind
 from articula.rigs.recorder import Recorder
+from articula.rigs.recording import RIGS, recording_config
+from articula.rigs.run import run_program
 from articula.runs.folders import check_out, claimed
 from articula.runs.registry import config_to_dict, experiment
 
-SAFE_CURRENT = 0.8  # [A] the largest current the excitation asks for (ACS712-5A: ±5 A)
+SAFE_CURRENT = 0.8  # [A] the largest current the motor's excitation asks for (ACS712-5A: ±5 A)
 # (constant [A], amplitude [A], frequency [Hz], duration [s]) of each part.
 MOTOR_EXCITATION = ((0.4, 0.4, 2.0, 20.0), (0.0, 0.7, 0.2, 20.0), (0.0, 0.5, 40.0, 5.0))
+SAFE_PWM = 220  # the largest valve count the PneuNet's excitation holds (of 255: 86 % duty)
+PNEUNET_EXCITATION = ((60, 5.0), (100, 5.0), (150, 5.0), (220, 5.0))  # (count, duration [s])
 
 
 def excitation_configs(seed: int) -> list[CurrentControlConfig]:
@@ -56,45 +65,91 @@ def excitation_configs(seed: int) -> list[CurrentControlConfig]:
     return configs
 
 
+def _motor_parts(link: Link, seed: int) -> list[Callable[[Path], None]]:
+    """The motor's parts, each recording one run into a folder."""
+    motor_current = experiment("motor.current")
+
+    def part(config: CurrentControlConfig) -> Callable[[Path], None]:
+        def record(folder: Path) -> None:
+            recorder = Recorder(folder, config_to_dict(motor_current, config), channels(link.info))
+            recorder.capture(lambda: run_on_rig(config, link, recorder), link.stats)
+
+        return record
+
+    return [part(config) for config in excitation_configs(seed)]
+
+
+def _pneunet_parts(link: Link, seed: int) -> list[Callable[[Path], None]]:
+    """The PneuNet's parts: a count held open-loop from rest, recorded as `rig record` does."""
+
+    def part(count: int, duration: float, k: int) -> Callable[[Path], None]:
+        def record(folder: Path) -> None:
+            link.command(Kind.SET_OUTPUT, struct.pack("<Bf", 0, float(count)))
+            config = recording_config(link, duration, seed + k)
+            recorder = Recorder(folder, config, [c.name for c in link.info.channels])
+
+            def run() -> dict[str, float]:
+                run_program(link, duration, seed + k, recorder.add)
+                return {}  # a recording has no metrics
+
+            recorder.capture(run, link.stats)
+
+        return record
+
+    return [part(c, d, k) for k, (c, d) in enumerate(PNEUNET_EXCITATION)]
+
+
+def excitation_summary(rig: str) -> dict[str, Any]:
+    """What identification.json states of the excitation a rig ran.
+
+    Args:
+        rig: the rig's name (motor or pneunet).
+
+    Returns:
+        The parts and the safe amplitude they keep.
+    """
+    if rig == "motor":
+        parts = [
+            {"current_A": c, "amplitude_A": a, "frequency_Hz": f, "duration_s": d}
+            for c, a, f, d in MOTOR_EXCITATION
+        ]
+        return {"excitation": parts, "safe_current_A": SAFE_CURRENT}
+    parts = [{"pwm_count": c, "duration_s": d} for c, d in PNEUNET_EXCITATION]
+    return {"excitation": parts, "safe_pwm_count": SAFE_PWM}
+
+
 def identify_on_rig(
     port: str,
-    rig: str,
     out_dir: Path,
     seed: int = 0,
     window: int = DEFAULT_WINDOW,
     force: bool = False,
-    progress=None,
+    progress: Callable[[], None] | None = None,
 ) -> dict[str, Any]:
     """Run the excitation on the rig, record each part into out_dir/excitation_<k>, fit.
 
     Args:
-        port: the rig's serial port.
-        rig: the rig's name (motor).
+        port: the rig's serial port (a motor or PneuNet rig).
         out_dir: the identification's folder.
         seed: the noise seed of an emulated rig.
-        window: the encoder's window [samples].
+        window: the motor encoder's window [samples].
         force: write into a folder holding other files.
         progress: called with no arguments after each part; None: silent.
 
     Returns:
         identification.json's content, with the excitation it ran.
     """
-    if rig != "motor":
-        raise ConfigError("RIG", f"rig identify runs on the motor rig so far (got {rig!r})")
     check_out(out_dir, "identification", force)
-    motor_current = experiment("motor.current")
-    folders = []
-    with Link(port, RigKind.MOTOR) as link, claimed(out_dir, "identification", force):
-        for k, config in enumerate(excitation_configs(seed), start=1):
-            folder = out_dir / f"excitation_{k}"
-            recorder = Recorder(folder, config_to_dict(motor_current, config), channels(link.info))
-            recorder.capture(lambda c=config, r=recorder: run_on_rig(c, link, r), link.stats)
-            folders.append(folder)
-            if progress is not None:
-                progress()
-        excitation = [
-            {"current_A": c, "amplitude_A": a, "frequency_Hz": f, "duration_s": d}
-            for c, a, f, d in MOTOR_EXCITATION
-        ]
-        extra = {"excitation": excitation, "safe_current_A": SAFE_CURRENT}
-        return fit_and_write(rig, folders, out_dir, window, extra)
+    with Link(port) as link:
+        rig = {kind: word for word, kind in RIGS.items()}[link.info.rig]
+        makers = {RigKind.MOTOR: _motor_parts, RigKind.PNEUNET: _pneunet_parts}
+        if link.info.rig not in makers:
+            raise ConfigError("PORT", f"rig identify runs on a motor or PneuNet rig (got {rig})")
+        folders = []
+        with claimed(out_dir, "identification", force):
+            for k, record in enumerate(makers[link.info.rig](link, seed), start=1):
+                folders.append(out_dir / f"excitation_{k}")
+                record(folders[-1])
+                if progress is not None:
+                    progress()
+            return fit_and_write(rig, folders, out_dir, window, excitation_summary(rig))

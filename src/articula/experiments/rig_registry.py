@@ -70,7 +70,7 @@ class RigEntry:
         """
         if plant is not None and not self.takes_plant:
             takers = " and ".join(e.name for e in RIGS.values() if e.takes_plant)
-            raise ConfigError("--plant", f"only the {takers} rig takes a plant config")
+            raise ConfigError("--plant", f"only the {takers} rigs take a plant config")
         if firmware is None:
             return Emulator(self.device(plant), realtime, Faults.parse(faults), seed)
         if faults:
@@ -89,10 +89,11 @@ RIGS = {
             "pneunet",
             RigKind.PNEUNET,
             "pneunet.pid",
-            lambda plant: PneuNetDevice(),
-            lambda plant: PneuNetPins(),
+            lambda plant: PneuNetDevice(pneunet_on_rig.plant_config(plant)),
+            lambda plant: PneuNetPins(pneunet_on_rig.plant_config(plant)),
             pneunet_on_rig.channels,
             pneunet_on_rig.run_on_rig,
+            takes_plant=True,
         ),
         RigEntry(
             "six-chamber",

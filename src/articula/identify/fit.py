@@ -4,14 +4,21 @@ and the constants the data do not determine named as such."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares
 
+from articula.errors import ConfigError
+
 UNDETERMINED = 0.25  # relative standard error above which a constant counts as not determined
 SPREAD = 10.0  # the fit keeps each constant within this factor of where it starts
+VALIDATION = 0.25  # the last quarter of each recording is kept for validation
+
+# A model's prediction: (constants, recording index) -> channel name -> values, shape (n,).
+Predict = Callable[[dict[str, float], int], dict[str, np.ndarray]]
 
 
 @dataclass(frozen=True)
@@ -101,3 +108,135 @@ def nrmse(measured: np.ndarray, model: np.ndarray) -> float:
     spread = float(np.std(measured))
     error = float(np.sqrt(np.mean((model - measured) ** 2)))
     return error / spread if spread > 0 else (0.0 if error == 0 else np.inf)
+
+
+@dataclass(frozen=True)
+class Curve:
+    """One channel of the first recording, measured and predicted, for the fit's figure.
+
+    Attributes:
+        label: the axis label (channel and unit).
+        t: sample times [s], shape (n,).
+        measured: the measured values, shape (n,).
+        model: the fitted model's, shape (n,).
+        validation_from: where the held-out part starts [s].
+    """
+
+    label: str
+    t: np.ndarray
+    measured: np.ndarray
+    model: np.ndarray
+    validation_from: float
+
+
+@dataclass(frozen=True)
+class Identification:
+    """A fit and how well it predicts the data it was not fitted to.
+
+    Attributes:
+        fit: the fitted constants, their standard errors, the undetermined ones.
+        validation_nrmse: channel -> NRMSE on the held-out part of every recording.
+        start: every constant the model takes, as the fit started (SI).
+        plant: the fitted plant as a config's tables (undetermined constants at their start).
+        curves: the first recording's channels, measured against the model.
+    """
+
+    fit: Fit
+    validation_nrmse: dict[str, float]
+    start: dict[str, float]
+    plant: dict[str, Any]
+    curves: tuple[Curve, ...]
+
+    @property
+    def constants(self) -> dict[str, float]:
+        """Every constant: the fitted ones, the rest at their start (SI)."""
+        return self.start | self.fit.values
+
+
+def fit_recordings(
+    predict: Predict,
+    measured: Sequence[Mapping[str, np.ndarray]],
+    start: dict[str, float],
+    free: Sequence[str],
+    first: Sequence[str] = (),
+) -> tuple[Fit, dict[str, float], dict[str, float]]:
+    """Fit `free` to the first three quarters of each recording, each channel's residuals
+    weighted by its noise over all of them; the NRMSE of each channel on the rest.
+
+    Args:
+        predict: (constants, recording index) -> channel -> the model's values.
+        measured: each recording's channels (the ones compared), name -> values, shape (n,).
+        start: every constant's start, SI, > 0.
+        free: the constants to fit.
+        first: constants fitted alone first, from the others' starts (ones a start estimate
+            leaves far off).
+
+    Returns:
+        The fit, channel -> validation NRMSE, and every constant where the full fit started
+        (after the `first` ones' own fit).
+    """
+    cuts = [int(len(next(iter(m.values()))) * (1 - VALIDATION)) for m in measured]
+    channels = list(measured[0])
+    # One recording that hardly moves a channel shows no noise on it: taken over all of them.
+    scale = {
+        c: _noise([m[c][:cut] for m, cut in zip(measured, cuts, strict=True)]) for c in channels
+    }
+
+    def residuals(constants: dict[str, float]) -> np.ndarray:
+        """The weighted residuals on every recording's fitted part."""
+        parts = []
+        for k, (m, cut) in enumerate(zip(measured, cuts, strict=True)):
+            model = predict(constants, k)
+            parts += [(model[c] - m[c])[:cut] / scale[c] for c in channels]
+        return np.concatenate(parts)
+
+    begin = dict(start)
+    if first:
+        begin |= fit_constants(residuals, begin, first).values
+    fit = fit_constants(residuals, begin, free)
+    constants = begin | fit.values
+    held: dict[str, tuple[list, list]] = {c: ([], []) for c in channels}
+    for k, (m, cut) in enumerate(zip(measured, cuts, strict=True)):
+        model = predict(constants, k)
+        for c in channels:
+            held[c][0].append(m[c][cut:])
+            held[c][1].append(model[c][cut:])
+    validation = {c: nrmse(np.concatenate(a), np.concatenate(b)) for c, (a, b) in held.items()}
+    return fit, validation, begin
+
+
+def _noise(signals: Sequence[np.ndarray]) -> float:
+    """The signals' noise level: the spread of their second differences (/√6, white noise's)."""
+    second = np.concatenate([np.diff(signal, 2) for signal in signals])
+    level = float(np.std(second) / np.sqrt(6.0))
+    spread = float(np.std(np.concatenate(signals)))
+    return level if level > 0 else max(spread, 1e-12)
+
+
+def sample_period(
+    columns: Mapping[str, np.ndarray], needed: Sequence[str], at_least: int, where: str, what: str
+) -> float:
+    """A recording's sample period, once it is checked to have the `needed` columns, at least
+    `at_least` samples and evenly spaced times (a lossy line leaves gaps).
+
+    Args:
+        columns: the recording's trace columns, name -> values (t [s] among them).
+        needed: the columns the fit takes besides t.
+        at_least: the fewest samples a fit takes.
+        where: the recording, named in errors.
+        what: the kind of recording, for the message ("motor", "PneuNet").
+
+    Returns:
+        The sample period [s].
+    """
+    missing = [c for c in ("t", *needed) if c not in columns]
+    if missing:
+        raise ConfigError(where, f"not a {what} recording: no {', '.join(missing)} column")
+    t = np.asarray(columns["t"], dtype=float)
+    if t.size < at_least:
+        raise ConfigError(where, f"{t.size} samples: a fit needs at least {at_least}")
+    steps = np.diff(t)
+    dt = float(np.median(steps))
+    if not (dt > 0 and np.allclose(steps, dt, rtol=1e-3, atol=1e-9)):
+        raise ConfigError(where, "samples are not evenly spaced (a lossy line?): record again")
+    return dt

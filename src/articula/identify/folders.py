@@ -8,39 +8,44 @@ from pathlib import Path
 from typing import Any
 
 from articula.errors import ConfigError
+from articula.identify.fit import Identification
 from articula.identify.motor import MotorRecording, identify_motor
+from articula.identify.pneunet import PneuNetRecording, identify_pneunet
 from articula.identify.report import write_identification
-from articula.runs.folders import TRACE, claimed
+from articula.runs.folders import TRACE, check_out, claimed
 from articula.runs.records import read_trace
 
-RIGS = ("motor",)  # the rigs whose models `identify` fits
+RIGS = ("motor", "pneunet")  # the rigs whose models `identify` fits
 DEFAULT_WINDOW = 50  # [samples] the motor firmware's encoder window (50 ms at 1 kHz)
 
 
-def read_recordings(rig: str, folders: Sequence[Path]) -> list[MotorRecording]:
-    """Each folder's trace.parquet as a recording the rig's fit takes.
+def identify_recordings(rig: str, folders: Sequence[Path], window: int) -> Identification:
+    """Read each folder's trace.parquet and fit the rig's model to them.
 
     Args:
-        rig: the rig's name.
-        folders: run folders of `articula rig record / run / identify` (their trace.parquet).
+        rig: the rig's name (motor or pneunet).
+        folders: run folders of `articula rig record / run / identify`.
+        window: the motor encoder's window [samples] (0: the recorded speed is the true one).
 
     Returns:
-        The recordings, in order.
+        The identification.
     """
     if rig not in RIGS:
         raise ConfigError(
             "RIG",
-            f"identify fits {', '.join(RIGS)} so far; the {rig} rig's fit is not built yet "
+            f"identify fits {' and '.join(RIGS)} so far; the {rig} rig's fit is not built yet "
             "(issue 30)",
         )
     if not folders:
         raise ConfigError("RECORDING", "give at least one recording folder")
-    recordings = []
+    traces = []
     for folder in folders:
         if not (folder / TRACE).is_file():
             raise ConfigError("RECORDING", f"{folder} has no {TRACE}: give a rig run's folder")
-        recordings.append(MotorRecording.from_columns(read_trace(folder), str(folder)))
-    return recordings
+        traces.append((read_trace(folder), str(folder)))
+    if rig == "motor":
+        return identify_motor([MotorRecording.from_columns(*t) for t in traces], window)
+    return identify_pneunet([PneuNetRecording.from_columns(*t) for t in traces])
 
 
 def identify_into(
@@ -53,18 +58,19 @@ def identify_into(
     """Fit the rig's model to the recordings and write the identification into out_dir.
 
     Args:
-        rig: the rig's name (motor).
+        rig: the rig's name (motor or pneunet).
         folders: the recordings' run folders.
         out_dir: the identification's folder (identification.json, plant.toml, fit.png).
-        window: the encoder's window [samples] (0: the recorded speed is the true one).
+        window: the motor encoder's window [samples] (0: the recorded speed is the true one).
         force: write into a folder holding other files.
 
     Returns:
         identification.json's content.
     """
-    recordings = read_recordings(rig, folders)  # a bad recording fails before out_dir exists
+    check_out(out_dir, "identification", force)
+    identification = identify_recordings(rig, folders, window)  # before out_dir exists
     with claimed(out_dir, "identification", force):
-        return fit_and_write(rig, folders, out_dir, window, recordings=recordings)
+        return _write(rig, identification, folders, out_dir, window, None)
 
 
 def fit_and_write(
@@ -73,23 +79,25 @@ def fit_and_write(
     out_dir: Path,
     window: int,
     extra: Mapping[str, Any] | None = None,
-    recordings: Sequence[MotorRecording] | None = None,
 ) -> dict[str, Any]:
     """Fit and write into out_dir, which the caller holds (runs.folders.claimed).
 
     Args:
-        rig: the rig's name (motor).
+        rig: the rig's name (motor or pneunet).
         folders: the recordings' run folders.
         out_dir: the identification's folder.
-        window: the encoder's window [samples].
-        extra: further keys for identification.json.
-        recordings: the recordings, already read from `folders`; None: read here.
+        window: the motor encoder's window [samples].
+        extra: further keys for identification.json (the excitation).
 
     Returns:
         identification.json's content.
     """
-    if recordings is None:
-        recordings = read_recordings(rig, folders)
-    identification = identify_motor(recordings, window)
+    identification = identify_recordings(rig, folders, window)
+    return _write(rig, identification, folders, out_dir, window, extra)
+
+
+def _write(rig, identification, folders, out_dir, window, extra) -> dict[str, Any]:
+    """write_identification with the sources and, for the motor, the encoder's window."""
+    extra = dict(extra or {}) | ({"encoder_window": window} if rig == "motor" else {})
     sources = [str(f) for f in folders]
-    return write_identification(out_dir, rig, identification, recordings, window, sources, extra)
+    return write_identification(out_dir, rig, identification, sources, extra)

@@ -12,14 +12,20 @@ from dataclasses import dataclass
 import numpy as np
 
 from articula.errors import ConfigError
-from articula.identify.fit import Fit, fit_constants, nrmse
+from articula.identify.fit import (
+    VALIDATION,
+    Curve,
+    Identification,
+    fit_recordings,
+    sample_period,
+)
 from articula.numba_cache import jit
 from articula.plants.dc_motor import TABLE_4_1, MotorParams
 from articula.plants.motor_rig import I_PRIMARY, OMEGA, THETA, discretize, rig_matrices
 
 CONSTANTS = ("R", "K", "b", "J", "L")
 CHANNELS = ("i_meas", "omega_meas")  # what the fit compares, with v1 as the input
-VALIDATION = 0.25  # the last quarter of each recording is kept for validation
+DRIVER_VOLTAGE = 12.0  # [V] the H-bridge's supply (experiments/motor.py's pwm.v_max default)
 
 
 @dataclass(frozen=True)
@@ -50,16 +56,7 @@ class MotorRecording:
         Returns:
             The recording.
         """
-        missing = [c for c in ("t", "v1", *CHANNELS) if c not in columns]
-        if missing:
-            raise ConfigError(where, f"not a motor recording: no {', '.join(missing)} column")
-        t = np.asarray(columns["t"], dtype=float)
-        if t.size < 100:
-            raise ConfigError(where, f"{t.size} samples: a fit needs at least 100")
-        steps = np.diff(t)
-        dt = float(np.median(steps))
-        if not (dt > 0 and np.allclose(steps, dt, rtol=1e-3, atol=1e-9)):
-            raise ConfigError(where, "samples are not evenly spaced (a lossy line?): record again")
+        dt = sample_period(columns, ("v1", *CHANNELS), 100, where, "motor")
         if "v2" in columns and np.any(np.asarray(columns["v2"]) != 0):
             raise ConfigError(
                 where,
@@ -108,29 +105,6 @@ def simulate(
     return states[:, I_PRIMARY], (theta - old) / (span * recording.dt)
 
 
-@dataclass(frozen=True)
-class Identification:
-    """A fit and how well it predicts the data it was not fitted to.
-
-    Attributes:
-        fit: the fitted constants, their standard errors, the undetermined ones.
-        validation_nrmse: channel -> NRMSE on the held-out part of every recording.
-        start: the constants the fit started from (an equation-error estimate), SI.
-    """
-
-    fit: Fit
-    validation_nrmse: dict[str, float]
-    start: dict[str, float]
-
-    def params(self) -> MotorParams:
-        """The fitted constants as a MotorParams (an undetermined one stays at the start).
-
-        Returns:
-            The motor's constants.
-        """
-        return MotorParams(**(self.start | self.fit.values))
-
-
 def identify_motor(
     recordings: Sequence[MotorRecording], window: int, start: MotorParams = TABLE_4_1
 ) -> Identification:
@@ -143,46 +117,37 @@ def identify_motor(
             positive value (the book's Table 4.1 by default).
 
     Returns:
-        The identification.
+        The identification; its plant, a motor.current config on the single rig.
     """
-    cuts = [int(r.v1.size * (1 - VALIDATION)) for r in recordings]
-    # Each channel's residuals weighted by its noise (the sensor's, the encoder's), taken over
-    # every recording: one that hardly moves the shaft shows the encoder no noise at all.
-    i_scale, w_scale = (
-        _noise([getattr(r, c)[:cut] for r, cut in zip(recordings, cuts, strict=True)])
-        for c in CHANNELS
-    )
 
-    def residuals(constants: dict[str, float]) -> np.ndarray:
-        """The weighted residuals on every recording's fitted part."""
-        params = MotorParams(**constants)
-        parts = []
-        for r, cut in zip(recordings, cuts, strict=True):
-            current, speed = simulate(params, r, window)
-            parts += [(current - r.i_meas)[:cut] / i_scale, (speed - r.omega_meas)[:cut] / w_scale]
-        return np.concatenate(parts)
+    def predict(constants: dict[str, float], k: int) -> dict[str, np.ndarray]:
+        """The rig model's channels for recording k."""
+        current, speed = simulate(MotorParams(**constants), recordings[k], window)
+        return {"i_meas": current, "omega_meas": speed}
 
-    begin = _integral_estimate(recordings, window, start)
+    measured = [{c: getattr(r, c) for c in CHANNELS} for r in recordings]
+    estimate = _integral_estimate(recordings, window, start)
     # L barely enters the integrals: fitted alone first, from the others' estimates.
-    begin |= fit_constants(residuals, begin, ["L"]).values
-    fit = fit_constants(residuals, begin, CONSTANTS)
-    params = MotorParams(**(begin | fit.values))
-    held: dict[str, list[np.ndarray]] = {c: [[], []] for c in CHANNELS}
-    for r, cut in zip(recordings, cuts, strict=True):
-        current, speed = simulate(params, r, window)
-        for channel, model in zip(CHANNELS, (current, speed), strict=True):
-            held[channel][0].append(getattr(r, channel)[cut:])
-            held[channel][1].append(model[cut:])
-    validation = {c: nrmse(np.concatenate(m), np.concatenate(p)) for c, (m, p) in held.items()}
-    return Identification(fit, validation, begin)
-
-
-def _noise(signals: Sequence[np.ndarray]) -> float:
-    """The signals' noise level: the spread of their second differences (/√6, white noise's)."""
-    second = np.concatenate([np.diff(signal, 2) for signal in signals])
-    level = float(np.std(second) / np.sqrt(6.0))
-    spread = float(np.std(np.concatenate(signals)))
-    return level if level > 0 else max(spread, 1e-12)
+    fit, validation, begin = fit_recordings(predict, measured, estimate, CONSTANTS, ["L"])
+    motor = MotorParams(**(begin | fit.values))
+    # A reference the fitted motor can hold at rest within the driver's 12 V: half its stall
+    # current there (the book's 1 A at 5 rad/s is beyond a motor of twice the book's R).
+    reference = {"current": round(0.5 * DRIVER_VOLTAGE / motor.R, 3), "speed": 0.0}
+    plant = {
+        "experiment": "motor.current",
+        "rig": "single",
+        "motor": motor.model_dump(),
+        "reference": reference,
+    }
+    first = recordings[0]
+    t = np.arange(first.v1.size) * first.dt
+    model = predict(motor.model_dump(), 0)
+    cut = t[int(t.size * (1 - VALIDATION))]
+    curves = tuple(
+        Curve(label, t, getattr(first, c), model[c], cut)
+        for c, label in zip(CHANNELS, ("current [A]", "speed [rad/s]"), strict=True)
+    )
+    return Identification(fit, validation, begin, plant, curves)
 
 
 def _integral_estimate(

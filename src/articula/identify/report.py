@@ -10,32 +10,26 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import tomli_w
 from matplotlib.figure import Figure
 
-from articula.identify.motor import VALIDATION, Identification, MotorRecording, simulate
+from articula.identify.fit import VALIDATION, Curve, Identification
 from articula.runs.folders import IDENTIFICATION
 from articula.runs.records import atomic_write
 
-DRIVER_VOLTAGE = 12.0  # [V] the H-bridge's supply (experiments/motor.py's pwm.v_max default)
 
-
-def summary(
-    rig: str, identification: Identification, window: int, sources: Sequence[str]
-) -> dict[str, Any]:
+def summary(rig: str, identification: Identification, sources: Sequence[str]) -> dict[str, Any]:
     """What identification.json holds (and `--json` prints).
 
     Args:
-        rig: the rig's name (motor).
+        rig: the rig's name.
         identification: the fit and its validation.
-        window: the encoder's window the fit assumed [samples].
         sources: the recording folders fitted, as given.
 
     Returns:
         rig, parameters (name -> value, SI), standard_errors, unidentifiable,
-        validation_nrmse, start (the book's constants the fit started from), encoder_window,
-        validation_fraction and recordings.
+        validation_nrmse, start (the constants the fit started from), validation_fraction
+        and recordings.
     """
     fit = identification.fit
     return {
@@ -45,31 +39,8 @@ def summary(
         "unidentifiable": list(fit.unidentifiable),
         "validation_nrmse": identification.validation_nrmse,
         "start": identification.start,
-        "encoder_window": window,
         "validation_fraction": VALIDATION,
         "recordings": list(sources),
-    }
-
-
-def plant_config(identification: Identification) -> dict[str, Any]:
-    """The fitted motor as a motor.current config on the single rig (`articula emulate motor
-    --plant`, `articula run`).
-
-    Args:
-        identification: the fit.
-
-    Returns:
-        The config's tables.
-    """
-    motor = identification.params()
-    # A reference the fitted motor can hold at rest within the driver's 12 V: half its stall
-    # current there (the book's 1 A at 5 rad/s is beyond a motor of twice the book's R).
-    reference = {"current": round(0.5 * DRIVER_VOLTAGE / motor.R, 3), "speed": 0.0}
-    return {
-        "experiment": "motor.current",
-        "rig": "single",
-        "motor": motor.model_dump(),
-        "reference": reference,
     }
 
 
@@ -77,8 +48,6 @@ def write_identification(
     folder: Path,
     rig: str,
     identification: Identification,
-    recordings: Sequence[MotorRecording],
-    window: int,
     sources: Sequence[str],
     extra: Mapping[str, Any] | None = None,
 ) -> dict[str, Any]:
@@ -88,41 +57,36 @@ def write_identification(
         folder: the identification's folder.
         rig: the rig's name.
         identification: the fit and its validation.
-        recordings: the recordings fitted.
-        window: the encoder's window the fit assumed [samples].
         sources: the recording folders, as given.
-        extra: further keys for identification.json (a rig identification's excitation).
+        extra: further keys for identification.json (the encoder's window, an excitation).
 
     Returns:
         identification.json's content.
     """
-    content = summary(rig, identification, window, sources) | dict(extra or {})
-    toml = tomli_w.dumps(plant_config(identification))
+    content = summary(rig, identification, sources) | dict(extra or {})
+    toml = tomli_w.dumps(identification.plant)
     if identification.fit.unidentifiable:
         kept = ", ".join(identification.fit.unidentifiable)
-        toml = f"# not determined by the data, the book's values kept: {kept}\n" + toml
+        toml = f"# not determined by the data, kept where the fit started: {kept}\n" + toml
     atomic_write(folder / "plant.toml", toml.encode())
-    _plot(folder / "fit.png", identification, recordings[0], window)
+    _plot(folder / "fit.png", rig, identification.curves)
     atomic_write(folder / IDENTIFICATION, (json.dumps(content, indent=2) + "\n").encode())
     return content
 
 
-def _plot(path: Path, identification: Identification, recording: MotorRecording, window: int):
+def _plot(path: Path, rig: str, curves: Sequence[Curve]) -> None:
     """Measured against model on the first recording, its held-out part shaded."""
-    current, speed = simulate(identification.params(), recording, window)
-    t = np.arange(recording.v1.size) * recording.dt
-    cut = t[int(t.size * (1 - VALIDATION))]
-    fig = Figure(figsize=(8, 5))  # no pyplot: nothing global, no backend to choose
-    axes = fig.subplots(2, 1, sharex=True)
-    rows = (("i_meas", current, "current [A]"), ("omega_meas", speed, "speed [rad/s]"))
-    for ax, (channel, model, label) in zip(axes, rows, strict=True):
-        ax.plot(t, getattr(recording, channel), lw=0.6, color="0.55", label="measured")
-        ax.plot(t, model, lw=1.0, color="tab:blue", label="fitted model")
-        ax.axvspan(cut, t[-1], color="tab:orange", alpha=0.12, label="validation")
-        ax.set_ylabel(label)
+    fig = Figure(figsize=(8, 2.5 * len(curves) + 0.5))  # no pyplot: nothing global
+    axes = fig.subplots(len(curves), 1, sharex=True, squeeze=False)[:, 0]
+    for ax, curve in zip(axes, curves, strict=True):
+        ax.plot(curve.t, curve.measured, lw=0.6, color="0.55", label="measured")
+        ax.plot(curve.t, curve.model, lw=1.0, color="tab:blue", label="fitted model")
+        ax.axvspan(curve.validation_from, curve.t[-1], color="tab:orange", alpha=0.12,
+                   label="validation")  # fmt: skip
+        ax.set_ylabel(curve.label)
     axes[0].legend(loc="upper right", fontsize=8)
     axes[-1].set_xlabel("t [s]")
-    axes[0].set_title("motor: measured against the fitted model (first recording)")
+    axes[0].set_title(f"{rig}: measured against the fitted model (first recording)")
     fig.tight_layout()
     png = io.BytesIO()
     fig.savefig(png, format="png", dpi=110)
