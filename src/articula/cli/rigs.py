@@ -16,7 +16,6 @@ from articula.cli.app import (
     metric_rows,
     out,
     print_table,
-    progress_bar,
 )
 
 rig_app = typer.Typer(no_args_is_help=True, help="A bench rig on a serial port.")
@@ -104,44 +103,3 @@ def record(
         emit_json(summary)
         return
     out.print(f"{summary['samples']} samples of {', '.join(summary['channels'])} in {out_dir}")
-
-
-@rig_app.command()
-def tune(
-    port: Port,
-    out_dir: OutDir,
-    method: Annotated[
-        str, typer.Option(help="descent (Algorithm 1), manual or ziegler-nichols.")
-    ] = "descent",
-    config: Annotated[
-        Path | None,
-        typer.Option(help="A chapter-2 tuning config (default: the book's quick one)."),
-    ] = None,
-    levels: Annotated[
-        str, typer.Option(help="Reference levels [deg], comma-separated (manual, Z-N: the first).")
-    ] = "30,60",
-    index: Annotated[int, typer.Option(min=0, help="Which run of the config's seeds.")] = 0,
-    force: Force = False,
-    as_json: JsonFlag = False,
-) -> None:
-    """Tune the PneuNet rig's PID with chapter 2's tuners, one experiment on the rig per
-    probe (counted live); writes tuning.json.
-
-    \b
-    Example: articula rig tune /dev/ttyACM0 --method descent --levels 30,60 --out runs/tuning"""
-    from articula.book.ch2.rig_tuning import parse_levels, tune_into
-
-    chosen = parse_levels(levels)
-    with progress_bar(as_json) as bar:
-        task = bar.add_task(f"{method}: experiments on the rig", total=None)
-        result = tune_into(
-            out_dir, port, method, config, chosen, index, force, lambda: bar.advance(task)
-        )
-    if as_json:
-        emit_json(result)
-        return
-    kp, ki, kd = result["gains"]
-    out.print(
-        f"{method}: K_p = {kp:.4g}, K_i = {ki:.4g}, K_d = {kd:.4g} after "
-        f"{result['experiments']} experiments; in {out_dir / 'tuning.json'}"
-    )

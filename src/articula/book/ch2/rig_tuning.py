@@ -1,6 +1,11 @@
 """Chapter 2's tuners on a PneuNet rig over serial (`articula rig tune`): the book's
 coordinate descent (Algorithm 1), scripted manual tuning and Ziegler-Nichols, each probe one
 experiment on the rig.
+
+With `--model PLANT.toml` (a fitted PneuNet, `articula identify`'s plant.toml) the descent runs
+on the model in simulation, then is confirmed on the rig: a descent on the rig from the model's
+gains, with steps of a tenth of them, for CONFIRM_SWEEPS sweep(s), every experiment on the rig
+counted (tune_on_model).
 """
 
 from __future__ import annotations
@@ -17,12 +22,15 @@ from articula.book.ch2.study import ZN_LADDER, ZN_SEED_OFFSET
 from articula.book.ch2.tuning import TuningConfig, auto_run, auto_seed, manual_seed
 from articula.book.study import packaged
 from articula.errors import ConfigError
+from articula.experiments.pneunet_on_rig import plant_config
+from articula.plants.pneunet import PneuNetParams
 from articula.rigs.link import Link
 from articula.rigs.pneunet import PneuNetRig
 from articula.rigs.programs import steps
 from articula.rigs.protocol import RigKind
 from articula.runs.folders import TUNING, check_out, claimed
 from articula.runs.records import atomic_write
+from articula.tuning.coordinate_descent import coordinate_descent
 from articula.tuning.manual import (
     GainExperiment,
     ManualSettings,
@@ -30,10 +38,42 @@ from articula.tuning.manual import (
     ultimate_gain,
     ziegler_nichols,
 )
-from articula.tuning.response import Response
+from articula.tuning.response import Response, tuning_cost
 from articula.validation import load_toml, parse_model
 
 TUNERS = ("descent", "manual", "ziegler-nichols")
+CONFIRM_SWEEPS = 1  # sweeps of the descent on the rig (each at most 6 experiments, + 1)
+CONFIRM_STEP = 0.1  # its probing steps, as a fraction of the model's gains
+
+
+def rig_experiment(
+    link: Link,
+    levels: tuple[float, ...],
+    hold: float,
+    seed: int,
+    on_experiment: Callable[[], None] | None = None,
+) -> GainExperiment:
+    """One experiment on the rig per call: steps through `levels` [°], each held `hold` [s],
+    with the gains K = (K_p, K_i, K_d) it is called with; on_experiment() before each.
+
+    Args:
+        link: the line to a PneuNet rig.
+        levels: the reference's levels [°].
+        hold: how long each is held [s].
+        seed: the noise seed of an emulated rig.
+        on_experiment: called before each experiment; None: nothing.
+
+    Returns:
+        The experiment: gains -> the rig's response.
+    """
+    on_rig = PneuNetRig(link, steps(levels, hold), len(levels) * hold, seed)
+
+    def experiment(k: np.ndarray) -> Response:
+        if on_experiment is not None:
+            on_experiment()
+        return on_rig(k)
+
+    return experiment
 
 
 def tune_on_rig(
@@ -50,14 +90,7 @@ def tune_on_rig(
     in-process runs' (an emulated rig then gives their numbers). Returns the result as JSON."""
 
     def rig(program_levels: tuple[float, ...], hold: float, seed: int) -> GainExperiment:
-        on_rig = PneuNetRig(link, steps(program_levels, hold), len(program_levels) * hold, seed)
-
-        def experiment(k: np.ndarray) -> Response:
-            if on_experiment is not None:
-                on_experiment()
-            return on_rig(k)
-
-        return experiment
+        return rig_experiment(link, program_levels, hold, seed, on_experiment)
 
     m, level = tuning.manual, levels[0]
     if method == "descent":
@@ -98,6 +131,53 @@ def tune_on_rig(
     }
 
 
+def tune_on_model(
+    tuning: TuningConfig,
+    plant: PneuNetParams,
+    link: Link,
+    levels: tuple[float, ...],
+    index: int = 0,
+    on_experiment: Callable[[], None] | None = None,
+) -> dict[str, Any]:
+    """Tune on the model, then confirm on the rig behind `link`.
+
+    Args:
+        tuning: the chapter-2 tuning config (its descent settings; its plant is replaced).
+        plant: the fitted PneuNet.
+        link: the line to the PneuNet rig.
+        levels: the reference's levels [°].
+        index: which run of the config's seeds (the start K and dK, the noise seeds).
+        on_experiment: called before each experiment on the rig.
+
+    Returns:
+        The result as JSON: gains and cost (confirmed on the rig), experiments (on the rig),
+        model_gains, model_cost and model_experiments (in simulation), confirm_sweeps.
+    """
+    model = auto_run(tuning.model_copy(update={"plant": plant}), levels, index).result
+    a = tuning.auto
+    experiment = rig_experiment(link, levels, a.hold, auto_seed(tuning, index), on_experiment)
+
+    def cost(k: np.ndarray) -> float:
+        r = experiment(k)
+        return float(tuning_cost(r.t, r.reference, r.measured))  # M(K), Eq. (2.5)
+
+    step = CONFIRM_STEP * np.abs(model.k) + 1e-6
+    confirmed = coordinate_descent(cost, model.k, step, a.k_stop, CONFIRM_SWEEPS,
+                                   lower=np.zeros(3), upper=np.array(a.upper))  # fmt: skip
+    return {
+        "method": "descent",
+        "model": True,
+        "levels_deg": list(levels),
+        "gains": confirmed.k.tolist(),
+        "cost": confirmed.cost,
+        "experiments": confirmed.evaluations,
+        "confirm_sweeps": CONFIRM_SWEEPS,
+        "model_gains": model.k.tolist(),
+        "model_cost": model.cost,
+        "model_experiments": model.evaluations,
+    }
+
+
 def parse_levels(levels: str) -> tuple[float, ...]:
     """Reference levels [°] from a comma-separated list (ConfigError naming --levels)."""
     try:
@@ -117,6 +197,7 @@ def tune_into(
     index: int,
     force: bool,
     on_experiment: Callable[[], None] | None = None,
+    model: Path | None = None,
 ) -> dict[str, Any]:
     """Tune the PneuNet rig on `port` and write the result to `out_dir`/tuning.json.
 
@@ -129,6 +210,9 @@ def tune_into(
         index: Which run of the config's seeds.
         force: Overwrite a run folder that holds other files.
         on_experiment: Called before each experiment on the rig.
+        model: A fitted plant (`articula identify pneunet`'s plant.toml) to tune on in
+            simulation first, then confirm on the rig (tune_on_model); descent
+            only. None: every experiment on the rig.
 
     Returns:
         The result, as written to tuning.json, with the link's statistics under "link".
@@ -139,9 +223,17 @@ def tune_into(
         )
     data = load_toml(config or packaged("ch2", "tuning_quick.toml"))
     tuning = parse_model(TuningConfig, data, str(config or "tuning_quick.toml"))
+    plant = None
+    if model is not None:
+        if method != "descent":
+            raise ConfigError("--model", f"tunes with the descent only (got --method {method})")
+        plant = plant_config(model)
     check_out(out_dir, "run", force)
     with Link(port, RigKind.PNEUNET) as link, claimed(out_dir, "run", force):
-        result = tune_on_rig(tuning, link, method, levels, index, on_experiment)
+        if plant is None:
+            result = tune_on_rig(tuning, link, method, levels, index, on_experiment)
+        else:
+            result = tune_on_model(tuning, plant, link, levels, index, on_experiment)
         result["link"] = dataclasses.asdict(link.stats)
         atomic_write(out_dir / TUNING, json.dumps(result, indent=2).encode())
     return result
