@@ -168,3 +168,19 @@ def load_toml(path: Path) -> dict[str, Any]:
         raise ConfigError(str(path), "not a UTF-8 text file; TOML must be UTF-8") from None
     except OSError as exc:
         raise ConfigError(str(path), f"cannot read the file ({exc.strerror})") from None
+
+
+def load_experiment_config(path: Path | None, model: type[M]) -> M:
+    """An experiment's config file read and validated (its `experiment` key optional), or the
+    model's defaults.
+
+    Args:
+        path: the TOML file; None: the defaults.
+        model: the experiment's config model.
+
+    Returns:
+        The config (ConfigError naming the file and key where it does not read).
+    """
+    data = {} if path is None else load_toml(path)
+    data.pop("experiment", None)
+    return parse_model(model, data, str(path or "defaults"))

@@ -11,8 +11,10 @@ import tomli_w
 
 from articula.errors import ArticulaError
 from articula.identify.pneunet import CONSTANTS as PNEUNET_CONSTANTS
+from articula.identify.six_chamber import CONSTANTS as SIX_CHAMBER_CONSTANTS
 from articula.plants.dc_motor import TABLE_4_1
 from articula.plants.pneunet import PneuNetParams
+from articula.plants.six_chamber import SixChamberParams
 
 
 def hidden_motor(seed: int, folder: Path) -> tuple[dict[str, float], Path]:
@@ -56,3 +58,14 @@ def assert_within(found: dict[str, float], hidden: dict[str, float], tolerance: 
     """Every hidden constant found within `tolerance` (relative)."""
     for name, value in hidden.items():
         assert abs(found[name] / value - 1) <= tolerance, (name, found[name], value)
+
+
+def hidden_six_chamber(seed: int, folder: Path) -> tuple[dict[str, float], Path]:
+    """A six-chamber actuator whose fitted constants are the defaults times factors in
+    [0.5, 2], and its softarm.damping config in `folder`."""
+    rng = np.random.default_rng(seed)
+    base = SixChamberParams()
+    drawn = {k: getattr(base, k) * 2.0 ** rng.uniform(-1, 1) for k in SIX_CHAMBER_CONSTANTS}
+    path = folder / f"hidden_six_chamber_{seed}.toml"
+    path.write_text(tomli_w.dumps({"actuator": drawn}))
+    return drawn, path

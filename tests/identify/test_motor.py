@@ -44,8 +44,8 @@ def test_a_hidden_motor_is_identified_through_the_line(seed, emulate_process, cl
     assert (tmp_path / "ident" / "fit.png").stat().st_size > 10_000
 
 
-def test_a_rig_without_a_fit_is_one_line_and_exit_2(cli, tmp_path):
-    proc = cli("identify", "six-chamber", tmp_path, "--out", tmp_path / "out")
+def test_an_unknown_rig_is_one_line_and_exit_2(cli, tmp_path):
+    proc = cli("identify", "arm", tmp_path, "--out", tmp_path / "out")
     assert proc.returncode == 2 and "RIG" in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
 

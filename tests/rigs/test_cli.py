@@ -131,7 +131,7 @@ def test_rig_info_of_an_emulated_pneunet(emulated_pneunet, cli):
         (["rig", "info", "/dev/no-such-rig"], "cannot open the port"),
         (["rig", "info", "/dev/null"], "cannot open the port"),
         (["emulate", "wobble"], "no rig called 'wobble'"),
-        (["emulate", "six-chamber", "--plant", "x.toml"], "only the pneunet and motor rigs"),
+        (["emulate", "six-chamber", "--plant", "/no/plant.toml"], "plant.toml"),
         (["emulate", "pneunet", "--faults", "drop=3"], "probability"),
         (["emulate", "motor", "--firmware", "/no/motor.elf"], "make -C firmware"),
         (["emulate", "pneunet", "--firmware", "x.elf", "--faults", "drop=0.1"], "not on firmware"),

@@ -32,7 +32,5 @@ def test_unknown_rigs_and_experiments_are_refused_by_name():
         rig_named("arm")
     with pytest.raises(ConfigError, match=r"experiment: baornn\.plan does not run on a rig"):
         rig_running("baornn.plan")
-    with pytest.raises(ConfigError, match="--plant: only the pneunet and motor rigs take a"):
-        rig_named("six-chamber").emulated(plant="x.toml")
     with pytest.raises(ConfigError, match="--faults: faults are injected by the Python device"):
         rig_named("six-chamber").emulated(firmware="six_chamber.elf", faults="drop=0.1")

@@ -31,7 +31,8 @@ def emulate(
         typer.Option(
             help="motor: a motor.current config whose rig, motor, dt, PWM, sensor and "
             "encoder the emulated rig has; pneunet: a pneunet.pid config whose [plant] it "
-            "has (default: the book's; `articula identify` writes one as plant.toml)."
+            "has; six-chamber: a softarm.damping config whose [actuator] it has (default: "
+            "the book's; `articula identify` writes one as plant.toml)."
         ),
     ] = None,
     firmware: Annotated[

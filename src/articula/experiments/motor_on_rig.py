@@ -34,7 +34,7 @@ from articula.rigs.programs import Program, Shape
 from articula.rigs.protocol import Info, Kind
 from articula.rigs.recorder import Recorder
 from articula.rigs.run import run_program
-from articula.validation import load_toml, parse_model
+from articula.validation import load_experiment_config
 
 DEVICE_CHANNELS = tuple(c.name for c in MEASURED + EMULATED)  # the emulated device's
 
@@ -61,9 +61,7 @@ def plant_config(path: Path | None) -> CurrentControlConfig:
     Returns:
         The config (ConfigError naming the file and key where it does not read).
     """
-    data = {} if path is None else load_toml(path)
-    data.pop("experiment", None)
-    return parse_model(CurrentControlConfig, data, str(path or "defaults"))
+    return load_experiment_config(path, CurrentControlConfig)
 
 
 def emulated_motor(config: CurrentControlConfig) -> MotorDevice:

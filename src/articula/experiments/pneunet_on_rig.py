@@ -23,7 +23,7 @@ from articula.rigs.protocol import Info, Kind
 from articula.rigs.recorder import Recorder
 from articula.rigs.run import run_program
 from articula.tuning.response import tracking_error, tuning_cost
-from articula.validation import load_toml, parse_model
+from articula.validation import load_experiment_config
 
 CHANNELS = ("trial", "theta_ref_deg", "theta_meas_deg", "pwm")  # the recorder's columns
 
@@ -51,9 +51,7 @@ def plant_config(path: Path | None) -> PneuNetParams:
     Returns:
         The actuator's constants (ConfigError naming the file and key where they do not read).
     """
-    data = {} if path is None else load_toml(path)
-    data.pop("experiment", None)
-    return parse_model(PneuNetPidConfig, data, str(path or "defaults")).plant
+    return load_experiment_config(path, PneuNetPidConfig).plant
 
 
 def reference_program(reference: AngleReference, duration: float) -> Program:

@@ -8,7 +8,8 @@ sinusoid about zero (J, from the speed swing) and a fast one (L and R, from the 
 response); the speed loop's gains are 0, so a load motor on the shaft is never driven. The
 PneuNet's is four open-loop steps of the valve's PWM count from rest (SET_OUTPUT), at most
 SAFE_PWM: the angles they settle at give the pressure-to-angle map, their rise the chamber's
-lag and the bending's frequency and damping.
+lag and the bending's frequency and damping. The six-chamber's is four actuations (a side
+filled to a share of the supply, held 1 s, vented, no damping pulse), the last held out.
 """
 
 from __future__ import annotations
@@ -19,15 +20,18 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from articula.errors import ConfigError
+from articula.control.damping import DampingPolicy
 from articula.experiments.motor import CurrentControlConfig, CurrentReference
 from articula.experiments.motor_on_rig import channels, run_on_rig
 from articula.identify.folders import DEFAULT_WINDOW, fit_and_write
+from articula.plants.six_chamber import SixChamberParams
 from articula.rigs.link import Link
+from articula.rigs.programs import Program, Shape
 from articula.rigs.protocol import Kind, RigKind
 from articula.rigs.recorder import Recorder
 from articula.rigs.recording import RIGS, recording_config
 from articula.rigs.run import run_program
+from articula.rigs.six_chamber import encode_damping
 from articula.runs.folders import check_out, claimed
 from articula.runs.registry import config_to_dict, experiment
 
@@ -36,6 +40,11 @@ SAFE_CURRENT = 0.8  # [A] the largest current the motor's excitation asks for (A
 MOTOR_EXCITATION = ((0.4, 0.4, 2.0, 20.0), (0.0, 0.7, 0.2, 20.0), (0.0, 0.5, 40.0, 5.0))
 SAFE_PWM = 220  # the largest valve count the PneuNet's excitation holds (of 255: 86 % duty)
 PNEUNET_EXCITATION = ((60, 5.0), (100, 5.0), (150, 5.0), (220, 5.0))  # (count, duration [s])
+# The six-chamber's: (side [deg], pressure [share of the book's 100 kPa supply], hold [s],
+# duration [s]);
+# the last is held out for validation. The rig refuses a pressure above its supply.
+SIX_CHAMBER_EXCITATION = ((0.0, 1.0, 1.0, 2.5), (120.0, 0.6, 1.0, 2.5), (240.0, 0.8, 1.0, 2.5),
+                          (60.0, 0.7, 1.0, 2.5))  # fmt: skip
 
 
 def excitation_configs(seed: int) -> list[CurrentControlConfig]:
@@ -85,25 +94,47 @@ def _pneunet_parts(link: Link, seed: int) -> list[Callable[[Path], None]]:
     def part(count: int, duration: float, k: int) -> Callable[[Path], None]:
         def record(folder: Path) -> None:
             link.command(Kind.SET_OUTPUT, struct.pack("<Bf", 0, float(count)))
-            config = recording_config(link, duration, seed + k)
-            recorder = Recorder(folder, config, [c.name for c in link.info.channels])
-
-            def run() -> dict[str, float]:
-                run_program(link, duration, seed + k, recorder.add)
-                return {}  # a recording has no metrics
-
-            recorder.capture(run, link.stats)
+            _record(link, folder, duration, seed + k)
 
         return record
 
     return [part(c, d, k) for k, (c, d) in enumerate(PNEUNET_EXCITATION)]
 
 
+def _six_chamber_parts(link: Link, seed: int) -> list[Callable[[Path], None]]:
+    """The six-chamber's parts: a side filled, held and vented (no damping pulse), recorded
+    as `rig record` does."""
+    supply = SixChamberParams().supply  # the book's pump; the rig refuses more than its own
+
+    def part(side: float, share: float, hold: float, duration: float, k: int):
+        def record(folder: Path) -> None:
+            program = Program(Shape.ACTUATION, (side, share * supply, hold))
+            link.command(Kind.SET_REFERENCE, program.encode())
+            link.command(Kind.SET_DAMPING, encode_damping(DampingPolicy()))
+            _record(link, folder, duration, seed + k)
+
+        return record
+
+    return [part(*p, k) for k, p in enumerate(SIX_CHAMBER_EXCITATION)]
+
+
+def _record(link: Link, folder: Path, duration: float, seed: int) -> None:
+    """A `rig record` of what the rig holds now into `folder`."""
+    recorder = Recorder(folder, recording_config(link, duration, seed),
+                        [c.name for c in link.info.channels])  # fmt: skip
+
+    def run() -> dict[str, float]:
+        run_program(link, duration, seed, recorder.add)
+        return {}  # a recording has no metrics
+
+    recorder.capture(run, link.stats)
+
+
 def excitation_summary(rig: str) -> dict[str, Any]:
     """What identification.json states of the excitation a rig ran.
 
     Args:
-        rig: the rig's name (motor or pneunet).
+        rig: the rig's name (motor, pneunet or six-chamber).
 
     Returns:
         The parts and the safe amplitude they keep.
@@ -114,8 +145,14 @@ def excitation_summary(rig: str) -> dict[str, Any]:
             for c, a, f, d in MOTOR_EXCITATION
         ]
         return {"excitation": parts, "safe_current_A": SAFE_CURRENT}
-    parts = [{"pwm_count": c, "duration_s": d} for c, d in PNEUNET_EXCITATION]
-    return {"excitation": parts, "safe_pwm_count": SAFE_PWM}
+    if rig == "pneunet":
+        parts = [{"pwm_count": c, "duration_s": d} for c, d in PNEUNET_EXCITATION]
+        return {"excitation": parts, "safe_pwm_count": SAFE_PWM}
+    parts = [
+        {"side_deg": a, "supply_fraction": f, "hold_s": h, "duration_s": d}
+        for a, f, h, d in SIX_CHAMBER_EXCITATION
+    ]
+    return {"excitation": parts, "held_out": "the last part"}
 
 
 def identify_on_rig(
@@ -129,7 +166,7 @@ def identify_on_rig(
     """Run the excitation on the rig, record each part into out_dir/excitation_<k>, fit.
 
     Args:
-        port: the rig's serial port (a motor or PneuNet rig).
+        port: the rig's serial port (any of the three rigs).
         out_dir: the identification's folder.
         seed: the noise seed of an emulated rig.
         window: the motor encoder's window [samples].
@@ -142,9 +179,11 @@ def identify_on_rig(
     check_out(out_dir, "identification", force)
     with Link(port) as link:
         rig = {kind: word for word, kind in RIGS.items()}[link.info.rig]
-        makers = {RigKind.MOTOR: _motor_parts, RigKind.PNEUNET: _pneunet_parts}
-        if link.info.rig not in makers:
-            raise ConfigError("PORT", f"rig identify runs on a motor or PneuNet rig (got {rig})")
+        makers = {
+            RigKind.MOTOR: _motor_parts,
+            RigKind.PNEUNET: _pneunet_parts,
+            RigKind.SIX_CHAMBER: _six_chamber_parts,
+        }
         folders = []
         with claimed(out_dir, "identification", force):
             for k, record in enumerate(makers[link.info.rig](link, seed), start=1):

@@ -36,7 +36,6 @@ class RigEntry:
         channels: The recorder's columns for the rig an INFO describes.
         run_on_rig: One run of an `experiment` config on the rig: (config, link, recorder) ->
             the run's metrics.
-        takes_plant: Whether a --plant config applies (otherwise the plant is the book's).
     """
 
     name: str
@@ -46,7 +45,6 @@ class RigEntry:
     pins: Callable[[Path | None], PinPlant]
     channels: Callable[[Info], tuple[str, ...]]
     run_on_rig: Callable[[Any, Link, Recorder], dict[str, float]]
-    takes_plant: bool = False
 
     def emulated(
         self,
@@ -59,7 +57,8 @@ class RigEntry:
         """A simulated rig of this kind behind a pseudo-terminal, serving until closed.
 
         Args:
-            plant: A config file of the plant (only where `takes_plant`); None: the book's.
+            plant: A config file of the plant (the rig's experiment's config: its motor,
+                [plant] or [actuator]); None: the book's.
             firmware: The rig's firmware ELF to run in simavr; None: the Python device.
             realtime: Pace samples at the rig's period instead of as fast as the host reads.
             faults: Faults injected by the Python device, e.g. "drop=0.01,delay_ms=20".
@@ -68,9 +67,6 @@ class RigEntry:
         Returns:
             The rig, serving inside a `with` block (`.path` is the port to open).
         """
-        if plant is not None and not self.takes_plant:
-            takers = " and ".join(e.name for e in RIGS.values() if e.takes_plant)
-            raise ConfigError("--plant", f"only the {takers} rigs take a plant config")
         if firmware is None:
             return Emulator(self.device(plant), realtime, Faults.parse(faults), seed)
         if faults:
@@ -93,14 +89,13 @@ RIGS = {
             lambda plant: PneuNetPins(pneunet_on_rig.plant_config(plant)),
             pneunet_on_rig.channels,
             pneunet_on_rig.run_on_rig,
-            takes_plant=True,
         ),
         RigEntry(
             "six-chamber",
             RigKind.SIX_CHAMBER,
             "softarm.damping",
-            lambda plant: SixChamberDevice(),
-            lambda plant: SixChamberPins(),
+            lambda plant: SixChamberDevice(six_chamber_on_rig.plant_config(plant)),
+            lambda plant: SixChamberPins(six_chamber_on_rig.plant_config(plant)),
             six_chamber_on_rig.channels,
             six_chamber_on_rig.run_on_rig,
         ),
@@ -112,7 +107,6 @@ RIGS = {
             lambda plant: motor_on_rig.firmware_motor(motor_on_rig.plant_config(plant)),
             motor_on_rig.channels,
             motor_on_rig.run_on_rig,
-            takes_plant=True,
         ),
     )
 }

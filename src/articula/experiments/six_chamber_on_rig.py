@@ -8,18 +8,36 @@ true angle and the chamber pressures are the simulation's alone).
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from articula.control.chamber_allocation import bend_direction
 from articula.experiments.six_chamber import DeactuationConfig, oscillation_metrics
+from articula.plants.six_chamber import SixChamberParams
 from articula.rigs.link import Link
 from articula.rigs.programs import Program, Shape
 from articula.rigs.protocol import Info, Kind
 from articula.rigs.recorder import Recorder
 from articula.rigs.run import run_program
 from articula.rigs.six_chamber import encode_damping
+from articula.validation import load_experiment_config
 
 CHANNELS = ("bend_x_deg", "bend_y_deg")  # the recorder's columns
+
+
+def plant_config(path: Path | None) -> SixChamberParams:
+    """The actuator an emulated rig has: the [actuator] table of a softarm.damping config
+    (what `articula identify six-chamber` writes as plant.toml).
+
+    Args:
+        path: A softarm.damping config file (its `experiment` key is optional); None: the
+            chapter's defaults.
+
+    Returns:
+        The actuator's constants (ConfigError naming the file and key where they do not read).
+    """
+    return load_experiment_config(path, DeactuationConfig).actuator
 
 
 def channels(info: Info) -> tuple[str, ...]:

@@ -2,4 +2,4 @@
 (`articula identify`, `articula rig identify`)."""
 
 # The public modules (imported by name, not here: `import articula` stays light).
-__all__ = ["fit", "folders", "motor", "pneunet", "report"]
+__all__ = ["fit", "folders", "motor", "pneunet", "report", "six_chamber"]

@@ -159,9 +159,14 @@ def fit_recordings(
     start: dict[str, float],
     free: Sequence[str],
     first: Sequence[str] = (),
+    hold_out_last: bool = False,
 ) -> tuple[Fit, dict[str, float], dict[str, float]]:
     """Fit `free` to the first three quarters of each recording, each channel's residuals
     weighted by its noise over all of them; the NRMSE of each channel on the rest.
+
+    Transients that settle within a recording (a six-chamber actuation) leave nothing but
+    noise in its last quarter: with `hold_out_last`, the last recording is held out whole and
+    the others are fitted whole.
 
     Args:
         predict: (constants, recording index) -> channel -> the model's values.
@@ -170,24 +175,31 @@ def fit_recordings(
         free: the constants to fit.
         first: constants fitted alone first, from the others' starts (ones a start estimate
             leaves far off).
+        hold_out_last: validate on the last recording, whole (needs two or more).
 
     Returns:
         The fit, channel -> validation NRMSE, and every constant where the full fit started
         (after the `first` ones' own fit).
     """
-    cuts = [int(len(next(iter(m.values()))) * (1 - VALIDATION)) for m in measured]
+    sizes = [len(next(iter(m.values()))) for m in measured]
+    if hold_out_last:
+        if len(measured) < 2:
+            raise ConfigError("RECORDING", "give two or more recordings: the last validates")
+        cuts = [*sizes[:-1], 0]
+    else:
+        cuts = [int(size * (1 - VALIDATION)) for size in sizes]
     channels = list(measured[0])
     # One recording that hardly moves a channel shows no noise on it: taken over all of them.
-    scale = {
-        c: _noise([m[c][:cut] for m, cut in zip(measured, cuts, strict=True)]) for c in channels
-    }
+    fitted = [(m, cut) for m, cut in zip(measured, cuts, strict=True) if cut > 0]
+    scale = {c: _noise([m[c][:cut] for m, cut in fitted]) for c in channels}
 
     def residuals(constants: dict[str, float]) -> np.ndarray:
         """The weighted residuals on every recording's fitted part."""
         parts = []
         for k, (m, cut) in enumerate(zip(measured, cuts, strict=True)):
-            model = predict(constants, k)
-            parts += [(model[c] - m[c])[:cut] / scale[c] for c in channels]
+            if cut > 0:  # a recording held out whole is not simulated
+                model = predict(constants, k)
+                parts += [(model[c] - m[c])[:cut] / scale[c] for c in channels]
         return np.concatenate(parts)
 
     begin = dict(start)
@@ -197,6 +209,8 @@ def fit_recordings(
     constants = begin | fit.values
     held: dict[str, tuple[list, list]] = {c: ([], []) for c in channels}
     for k, (m, cut) in enumerate(zip(measured, cuts, strict=True)):
+        if cut == sizes[k]:
+            continue  # fitted whole: nothing of it held out
         model = predict(constants, k)
         for c in channels:
             held[c][0].append(m[c][cut:])

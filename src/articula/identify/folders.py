@@ -12,10 +12,12 @@ from articula.identify.fit import Identification
 from articula.identify.motor import MotorRecording, identify_motor
 from articula.identify.pneunet import PneuNetRecording, identify_pneunet
 from articula.identify.report import write_identification
-from articula.runs.folders import TRACE, check_out, claimed
+from articula.identify.six_chamber import SixChamberRecording, identify_six_chamber
+from articula.runs.folders import CONFIG, TRACE, check_out, claimed
 from articula.runs.records import read_trace
+from articula.validation import load_toml
 
-RIGS = ("motor", "pneunet")  # the rigs whose models `identify` fits
+RIGS = ("motor", "pneunet", "six-chamber")  # the rigs whose models `identify` fits
 DEFAULT_WINDOW = 50  # [samples] the motor firmware's encoder window (50 ms at 1 kHz)
 
 
@@ -23,19 +25,16 @@ def identify_recordings(rig: str, folders: Sequence[Path], window: int) -> Ident
     """Read each folder's trace.parquet and fit the rig's model to them.
 
     Args:
-        rig: the rig's name (motor or pneunet).
-        folders: run folders of `articula rig record / run / identify`.
+        rig: the rig's name (motor, pneunet or six-chamber).
+        folders: run folders of `articula rig record / run / identify` (six-chamber: `rig
+            record` folders, whose config.toml holds the actuation).
         window: the motor encoder's window [samples] (0: the recorded speed is the true one).
 
     Returns:
         The identification.
     """
     if rig not in RIGS:
-        raise ConfigError(
-            "RIG",
-            f"identify fits {' and '.join(RIGS)} so far; the {rig} rig's fit is not built yet "
-            "(issue 30)",
-        )
+        raise ConfigError("RIG", f"no rig called {rig!r}; choose one of {', '.join(RIGS)}")
     if not folders:
         raise ConfigError("RECORDING", "give at least one recording folder")
     traces = []
@@ -45,7 +44,13 @@ def identify_recordings(rig: str, folders: Sequence[Path], window: int) -> Ident
         traces.append((read_trace(folder), str(folder)))
     if rig == "motor":
         return identify_motor([MotorRecording.from_columns(*t) for t in traces], window)
-    return identify_pneunet([PneuNetRecording.from_columns(*t) for t in traces])
+    if rig == "pneunet":
+        return identify_pneunet([PneuNetRecording.from_columns(*t) for t in traces])
+    runs = [
+        SixChamberRecording.from_run(columns, load_toml(Path(where) / CONFIG), where)
+        for columns, where in traces
+    ]
+    return identify_six_chamber(runs)
 
 
 def identify_into(
@@ -58,7 +63,7 @@ def identify_into(
     """Fit the rig's model to the recordings and write the identification into out_dir.
 
     Args:
-        rig: the rig's name (motor or pneunet).
+        rig: the rig's name (motor, pneunet or six-chamber).
         folders: the recordings' run folders.
         out_dir: the identification's folder (identification.json, plant.toml, fit.png).
         window: the motor encoder's window [samples] (0: the recorded speed is the true one).
@@ -83,7 +88,7 @@ def fit_and_write(
     """Fit and write into out_dir, which the caller holds (runs.folders.claimed).
 
     Args:
-        rig: the rig's name (motor or pneunet).
+        rig: the rig's name (motor, pneunet or six-chamber).
         folders: the recordings' run folders.
         out_dir: the identification's folder.
         window: the motor encoder's window [samples].

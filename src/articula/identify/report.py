@@ -86,7 +86,7 @@ def _plot(path: Path, rig: str, curves: Sequence[Curve]) -> None:
         ax.set_ylabel(curve.label)
     axes[0].legend(loc="upper right", fontsize=8)
     axes[-1].set_xlabel("t [s]")
-    axes[0].set_title(f"{rig}: measured against the fitted model (first recording)")
+    axes[0].set_title(f"{rig}: measured against the fitted model (shaded: held out of the fit)")
     fig.tight_layout()
     png = io.BytesIO()
     fig.savefig(png, format="png", dpi=110)
