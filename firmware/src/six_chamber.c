@@ -22,7 +22,11 @@
 #include <string.h>
 #include <util/atomic.h>
 
+#ifdef FILL_TABLE /* make FILL_TABLE=fill.h: another actuator's (tools/fill_table.py --plant) */
+#include FILL_TABLE
+#else
 #include "fill_table.h"
+#endif
 #include "probe.h"
 #include "protocol.h"
 #include "rig.h"

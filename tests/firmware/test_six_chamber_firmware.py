@@ -65,7 +65,7 @@ def test_the_policy_found_in_simulation_damps_the_firmware_rig_the_same_way(rig,
     assert on_there["settling_s"] == pytest.approx(on_here["settling_s"], abs=0.0101)
 
 
-def test_what_the_firmware_cannot_do_is_refused_by_name(rig, tmp_path):
+def test_what_the_firmware_cannot_do_is_refused_by_name(rig, built, tmp_path):
     recorder = Recorder(tmp_path, {"experiment": "softarm.damping"}, CHANNELS)
     with pytest.raises(DeviceError, match="multiple of 60 deg"):
         run_on_rig(DeactuationConfig(side_deg=30.0), rig, recorder)
@@ -74,8 +74,8 @@ def test_what_the_firmware_cannot_do_is_refused_by_name(rig, tmp_path):
         run_on_rig(late, rig, recorder)
     with pytest.raises(ConfigError, match=r"sensor\.rate"):
         SixChamberPins(sensor=OrientationSensorParams(rate=50.0))
-    with pytest.raises(ConfigError, match=r"fill_table\.h"):
-        SixChamberPins(SixChamberParams(supply=80e3))
+    with pytest.raises(ConfigError, match=r"fill_table\.h"):  # its table is another's
+        SixChamberPins(SixChamberParams(supply=80e3), firmware=built / "six_chamber.elf")
 
 
 def test_the_fill_table_in_the_firmware_is_the_models():

@@ -9,7 +9,7 @@ response); the speed loop's gains are 0, so a load motor on the shaft is never d
 PneuNet's is four open-loop steps of the valve's PWM count from rest (SET_OUTPUT), at most
 SAFE_PWM: the angles they settle at give the pressure-to-angle map, their rise the chamber's
 lag and the bending's frequency and damping. The six-chamber's is four actuations (a side
-filled to a share of the supply, held 1 s, vented, no damping pulse), the last held out.
+filled to the supply, held 0.6-1 s, vented, no damping pulse), the last held out.
 """
 
 from __future__ import annotations
@@ -41,10 +41,14 @@ MOTOR_EXCITATION = ((0.4, 0.4, 2.0, 20.0), (0.0, 0.7, 0.2, 20.0), (0.0, 0.5, 40.
 SAFE_PWM = 220  # the largest valve count the PneuNet's excitation holds (of 255: 86 % duty)
 PNEUNET_EXCITATION = ((60, 5.0), (100, 5.0), (150, 5.0), (220, 5.0))  # (count, duration [s])
 # The six-chamber's: (side [deg], pressure [share of the book's 100 kPa supply], hold [s],
-# duration [s]);
-# the last is held out for validation. The rig refuses a pressure above its supply.
-SIX_CHAMBER_EXCITATION = ((0.0, 1.0, 1.0, 2.5), (120.0, 0.6, 1.0, 2.5), (240.0, 0.8, 1.0, 2.5),
-                          (60.0, 0.7, 1.0, 2.5))  # fmt: skip
+# duration [s]); the last is held out for validation. At the supply and on a chamber's side
+# (a multiple of 60°): all the firmware fills; the rig refuses more than its supply.
+SIX_CHAMBER_EXCITATION = (
+    (0.0, 1.0, 1.0, 2.5),
+    (120.0, 1.0, 0.6, 2.0),
+    (240.0, 1.0, 0.8, 2.3),
+    (60.0, 1.0, 1.0, 2.5),
+)
 
 
 def excitation_configs(seed: int) -> list[CurrentControlConfig]:

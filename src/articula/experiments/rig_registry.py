@@ -32,7 +32,8 @@ class RigEntry:
         kind: The kind the rig reports in its INFO.
         experiment: The registered experiment its host driver runs (`articula rig run`).
         device: The Python device of an emulated rig, from a --plant config file or None.
-        pins: The simulated plant behind its firmware's pins, from the same.
+        pins: The simulated plant behind its firmware's pins, from the same and the
+            firmware's ELF (the six-chamber's is checked to hold the actuator's fill table).
         channels: The recorder's columns for the rig an INFO describes.
         run_on_rig: One run of an `experiment` config on the rig: (config, link, recorder) ->
             the run's metrics.
@@ -42,7 +43,7 @@ class RigEntry:
     kind: RigKind
     experiment: str
     device: Callable[[Path | None], Device]
-    pins: Callable[[Path | None], PinPlant]
+    pins: Callable[[Path | None, Path], PinPlant]
     channels: Callable[[Info], tuple[str, ...]]
     run_on_rig: Callable[[Any, Link, Recorder], dict[str, float]]
 
@@ -75,7 +76,7 @@ class RigEntry:
                 "faults are injected by the Python device, not on firmware; "
                 "leave out --firmware or --faults",
             )
-        return FirmwareRig(firmware, self.pins(plant), realtime)
+        return FirmwareRig(firmware, self.pins(plant, firmware), realtime)
 
 
 RIGS = {
@@ -86,7 +87,7 @@ RIGS = {
             RigKind.PNEUNET,
             "pneunet.pid",
             lambda plant: PneuNetDevice(pneunet_on_rig.plant_config(plant)),
-            lambda plant: PneuNetPins(pneunet_on_rig.plant_config(plant)),
+            lambda plant, elf: PneuNetPins(pneunet_on_rig.plant_config(plant)),
             pneunet_on_rig.channels,
             pneunet_on_rig.run_on_rig,
         ),
@@ -95,7 +96,7 @@ RIGS = {
             RigKind.SIX_CHAMBER,
             "softarm.damping",
             lambda plant: SixChamberDevice(six_chamber_on_rig.plant_config(plant)),
-            lambda plant: SixChamberPins(six_chamber_on_rig.plant_config(plant)),
+            lambda plant, elf: SixChamberPins(six_chamber_on_rig.plant_config(plant), firmware=elf),
             six_chamber_on_rig.channels,
             six_chamber_on_rig.run_on_rig,
         ),
@@ -104,7 +105,7 @@ RIGS = {
             RigKind.MOTOR,
             "motor.current",
             lambda plant: motor_on_rig.emulated_motor(motor_on_rig.plant_config(plant)),
-            lambda plant: motor_on_rig.firmware_motor(motor_on_rig.plant_config(plant)),
+            lambda plant, elf: motor_on_rig.firmware_motor(motor_on_rig.plant_config(plant)),
             motor_on_rig.channels,
             motor_on_rig.run_on_rig,
         ),
