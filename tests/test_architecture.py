@@ -15,6 +15,7 @@ PACKAGE = SRC / "articula"
 LAYERS = {
     "errors": 0,
     "limits": 0,
+    "signals": 0,
     "native": 0,
     "disk_cache": 0,
     "numba_cache": 1,

@@ -76,4 +76,4 @@ def test_the_live_page_shows_the_measured_arm(scene_file, viewer, browser, tmp_p
     r, g, b = view[..., 0], view[..., 1], view[..., 2]
     assert np.sum((b > 120) & (b > 1.3 * r) & (b > 1.1 * g)) > 2000  # the measured arm's blue
     proc.send_signal(signal.SIGINT)
-    assert proc.wait(30) == 0
+    assert proc.wait(30) == 130

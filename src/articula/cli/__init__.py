@@ -3,7 +3,8 @@
 Exit status: 0 done; 2 bad input (the line names the field or option and the fix); 1 the
 machine stopped the work (disk full, folder in use, I/O error, out of memory); 3 a bug of
 articula's (the line says so; ARTICULA_DEBUG=1 shows the traceback); 4 a planned motion
-collides (its run folder is written); 130 interrupted.
+collides (its run folder is written); 130 interrupted (Ctrl-C); 143 terminated (SIGTERM: a
+viewer, live loop or emulated rig ends as on Ctrl-C).
 """
 
 from __future__ import annotations
@@ -21,8 +22,9 @@ from articula.cli import arm, bench, book, emulate, identify, rig_tune, rigs, ru
 from articula.cli.app import app
 from articula.cli.words import speak_in_words
 from articula.errors import ArticulaError, CollisionError, DeviceError, ResourceError
+from articula.signals import Terminated
 
-BAD_INPUT, ENVIRONMENT, BUG, COLLIDES, INTERRUPTED = 2, 1, 3, 4, 130
+BAD_INPUT, ENVIRONMENT, BUG, COLLIDES, INTERRUPTED, TERMINATED = 2, 1, 3, 4, 130, 143
 # OS errors that the machine causes; every other OSError is about a path the user gave.
 MACHINE_ERRNOS = {
     errno.ENOSPC,
@@ -50,6 +52,8 @@ def main(argv: list[str] | None = None) -> None:
             if debug:
                 raise
             _fail(*_status_and_message(exc))
+        except Terminated:
+            _fail(TERMINATED, "terminated (SIGTERM); finished work is kept, as on Ctrl-C")
         except KeyboardInterrupt:
             _fail(
                 INTERRUPTED,

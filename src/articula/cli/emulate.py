@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import contextlib
 import threading
 from pathlib import Path
 from typing import Annotated
@@ -51,9 +50,9 @@ def emulate(
     \b
     Example: articula emulate motor --firmware firmware/build/motor.elf"""
     from articula.experiments.rig_registry import rig_named
+    from articula.signals import terminate_as_interrupt
 
     emulator = rig_named(rig).emulated(plant, firmware, realtime, faults, seed)
-    with emulator:
+    with terminate_as_interrupt(), emulator:  # Ctrl-C or SIGTERM: the rig stops, 130 or 143
         out.print(f"{rig} rig at {emulator.path} (Ctrl-C stops it)")
-        with contextlib.suppress(KeyboardInterrupt):
-            threading.Event().wait()
+        threading.Event().wait()

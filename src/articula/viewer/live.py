@@ -30,6 +30,7 @@ from articula.planning.config import (
     absolute_paths,
 )
 from articula.scene.scene import Scene
+from articula.signals import Terminated, terminate_as_interrupt
 from articula.validation import load_toml
 from articula.viewer import drawing
 from articula.viewer.live_plant import COMMANDED_OPACITY, LivePlant
@@ -348,7 +349,8 @@ def run_live(
     announce,
     plant: str | None = None,
 ) -> None:
-    """Serve the live page until Ctrl-C, a period every dt; then write --record if asked.
+    """Serve the live page until Ctrl-C or SIGTERM, a period every dt; then write --record if
+    asked, and the interrupt goes on (the CLI exits 130 or 143).
 
     Args:
         scene_file: the scene TOML to run (with [planner] and [trajectory]).
@@ -364,24 +366,27 @@ def run_live(
     loaded = LiveScene.load(scene_file, method, plant)  # a bad file fails before the port opens
     server = open_server(host, port)
     started = time.monotonic()
-    live = None
-    try:
-        live = Live(server, loaded)
-        announce(f"http://{host}:{port}")
-        next_period = time.perf_counter()
-        while True:
-            live.period()
-            next_period += live.dt
-            pause = next_period - time.perf_counter()
-            if pause > 0:
-                time.sleep(pause)
-            else:
-                next_period = time.perf_counter()  # late: start the next period now
-    except KeyboardInterrupt:
-        pass
-    finally:
-        if live is not None:
-            live.close()
-        stop_server(server)
-    if record is not None and live is not None:
-        live.write(record, time.monotonic() - started)
+    live, interrupted = None, False
+    with terminate_as_interrupt():
+        try:
+            live = Live(server, loaded)
+            live.period()  # the loop runs before the URL goes out: a record is never empty
+            announce(f"http://{host}:{port}")
+            next_period = time.perf_counter()
+            while True:
+                next_period += live.dt
+                pause = next_period - time.perf_counter()
+                if pause > 0:
+                    time.sleep(pause)
+                else:
+                    next_period = time.perf_counter()  # late: start the next period now
+                live.period()
+        except (KeyboardInterrupt, Terminated):  # Ctrl-C or SIGTERM: the session is written
+            interrupted = True
+            raise
+        finally:
+            if live is not None:
+                live.close()
+            stop_server(server)
+            if interrupted and record is not None and live is not None:
+                live.write(record, time.monotonic() - started)

@@ -9,6 +9,7 @@ play/pause and speed, and plots of error and clearance against time.
 
 from __future__ import annotations
 
+import errno
 import socket
 import time
 from pathlib import Path
@@ -19,6 +20,7 @@ import viser.uplot as uplot
 
 from articula.errors import ConfigError
 from articula.native import captured_output
+from articula.signals import terminate_as_interrupt
 from articula.viewer import drawing
 from articula.viewer.run_data import RunData, load_run, run_folders
 
@@ -152,7 +154,8 @@ class Replay:
 
 
 def open_server(host: str, port: int) -> viser.ViserServer:
-    """A viser server on host:port; ConfigError naming --port when it is taken.
+    """A viser server on host:port; ConfigError naming --port when it is taken, --host when
+    the address is not this machine's.
 
     Args:
         host: the address to listen on.
@@ -166,8 +169,14 @@ def open_server(host: str, port: int) -> viser.ViserServer:
         try:
             probe.bind((host, port))
         except OSError as exc:
-            raise ConfigError(
-                "--port", f"cannot listen on {host}:{port} ({exc.strerror}); choose another port"
+            if exc.errno in (errno.EADDRINUSE, errno.EACCES):  # the port: taken or privileged
+                raise ConfigError(
+                    "--port", f"cannot listen on {host}:{port} ({exc.strerror}); choose another"
+                ) from None
+            raise ConfigError(  # not a name or address of this machine
+                "--host",
+                f"cannot listen on {host} ({exc.strerror or exc}); give an address of this "
+                "machine, e.g. 127.0.0.1 or 0.0.0.0",
             ) from None
     with captured_output():  # viser's banner: the command prints its own one line
         return viser.ViserServer(host=host, port=port, verbose=False)
@@ -184,8 +193,8 @@ def stop_server(server: viser.ViserServer) -> None:
 
 
 def serve(folder: Path, host: str, port: int, announce) -> None:
-    """Serve the replay of `folder` until Ctrl-C (a normal end: it returns); announce(url)
-    once it listens.
+    """Serve the replay of `folder` until Ctrl-C or SIGTERM (KeyboardInterrupt or
+    signals.Terminated goes on once the server is stopped); announce(url) once it listens.
 
     Args:
         folder: a planner's run folder, or a sweep's folder of them.
@@ -196,16 +205,15 @@ def serve(folder: Path, host: str, port: int, announce) -> None:
     runs = run_folders(folder)
     load_run(runs[0])  # a bad run fails before the server starts
     server = open_server(host, port)
-    try:
-        replay = Replay(server, runs)
-        announce(f"http://{host}:{port}")
-        last = time.monotonic()
-        while True:
-            time.sleep(FRAME_S)
-            now = time.monotonic()
-            replay.tick(now - last)
-            last = now
-    except KeyboardInterrupt:
-        return
-    finally:
-        stop_server(server)
+    with terminate_as_interrupt():
+        try:
+            replay = Replay(server, runs)
+            announce(f"http://{host}:{port}")
+            last = time.monotonic()
+            while True:
+                time.sleep(FRAME_S)
+                now = time.monotonic()
+                replay.tick(now - last)
+                last = now
+        finally:
+            stop_server(server)
