@@ -16,7 +16,7 @@ import viser
 from articula.scene import Obstacle, Scene
 from articula.validation import load_toml
 from articula.viewer.drawing import pose_of
-from articula.viewer.live import Live, LiveScene
+from articula.viewer.live import READOUT_EVERY, Live, LiveScene
 from articula.viewer.run_data import load_run
 from tests.viewer.conftest import (
     CONFIGS,
@@ -83,10 +83,19 @@ def test_the_panel_rebuilds_the_controller_and_refuses_a_start_within_d_min(serv
     q = np.array(live.recording.q)
     acceleration = np.abs(np.diff(q, 2, axis=0)) / live.dt**2
     assert np.all(acceleration <= live.scene.robot.acceleration_limit * (1 + 1e-9))
-    old = live.controller
-    live.d_min.value = 5.0  # farther than any obstacle is
-    live.rebuild()
+    old, in_force = live.controller, live.d_min.value
+    live.d_min.value = 5.0  # farther than any obstacle is (the panel's update rebuilds)
     assert live.controller is old and "not changed" in live.readout.content
+    assert live.d_min.value == in_force  # the panel shows the setting in force
+    for _ in range(3 * READOUT_EVERY):  # readouts go out: the refusal stays in them
+        live.period()
+    assert live.painter.flush()
+    assert "not changed" in live.readout.content and "clearance" in live.readout.content
+    live.d_min.value = in_force / 2  # the next change clears it
+    for _ in range(READOUT_EVERY):
+        live.period()
+    assert live.painter.flush()
+    assert "not changed" not in live.readout.content
 
 
 def test_the_live_page_renders_in_two_tabs_and_ctrl_c_writes_the_record(

@@ -60,8 +60,10 @@ def live(
     Example: articula live src/articula/book/ch1/configs/circle_two_obstacles.toml --method qp
     With the arm's dynamics: ... --plant mujoco (the measured arm drawn in blue)"""
     from articula.errors import ConfigError
+    from articula.planning.config import METHODS
     from articula.runs.folders import check_out
-    from articula.viewer.live import METHODS, PLANTS, run_live
+    from articula.viewer.live import run_live
+    from articula.viewer.live_scene import PLANTS
 
     if method is not None and method not in METHODS:
         raise ConfigError(

@@ -4,6 +4,9 @@
 __all__ = [
     "drawing",
     "live",
+    "live_plant",
+    "live_record",
+    "live_scene",
     "painter",
     "replay",
     "run_data",

@@ -13,7 +13,6 @@ drawn beside the commanded one.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -21,81 +20,25 @@ import numpy as np
 import viser
 
 from articula.errors import ArticulaError
-from articula.experiments.plan import PlanConfig, build_plan
 from articula.loops.online import OnlineController
-from articula.planning.approach import Approach
 from articula.planning.config import (
     METHODS,
     PlannerSpec,
-    absolute_paths,
 )
-from articula.scene.scene import Scene
 from articula.signals import Terminated, terminate_as_interrupt
-from articula.validation import load_toml
 from articula.viewer import drawing
 from articula.viewer.live_plant import COMMANDED_OPACITY, LivePlant
 from articula.viewer.live_record import Recording
+from articula.viewer.live_scene import LiveScene
 from articula.viewer.painter import Painter
 from articula.viewer.run_data import visuals_of
 
 READOUT_EVERY = 9  # periods between readouts (~10 a second, what a person reads); a
 # multiple of DRAW_EVERY, as a readout goes out with a picture
 DRAW_EVERY = 3  # periods between pictures: 33 Hz at 10 ms, smooth to the eye (each is
+
+
 # pushed to the page by the painter's thread, viewer/painter.py: the loop never waits on it)
-PLANTS = ("mujoco", "none")  # `live --plant`
-DEFAULT_SERVO_RATE = 1000.0  # [Hz] the twin's servo rate where the scene file has no [servo]
-
-
-@dataclass
-class LiveScene:
-    """A scene file read and checked for `live`: its plan config (the method given, if one
-    was), scene, start configuration [rad] and end-effector path.
-
-    Attributes:
-        config: the scene file as a plan config (its paths absolute).
-        scene: the robot and obstacles.
-        q0: the start configuration, shape (n,) [rad].
-        targets: the end-effector's reference (t [s] -> target): the approach from the tool
-            to the path's start, then the path.
-        validated: the plan config as validated ([plant] and [servo] included).
-    """
-
-    config: dict[str, Any]
-    scene: Scene
-    q0: np.ndarray
-    targets: Approach
-    validated: PlanConfig
-
-    @classmethod
-    def load(
-        cls, scene_file: Path, method: str | None = None, plant: str | None = None
-    ) -> LiveScene:
-        """Read scene_file; an ArticulaError (before any server opens) when its planner does
-        not validate or cannot start from its q0.
-
-        Args:
-            scene_file: a scene TOML with [planner] and [trajectory] tables.
-            method: the planner method to use instead of the file's; None: the file's.
-            plant: "mujoco" (the dynamics twin, at the file's [servo] rate or 1 kHz) or "none"
-                (the arm is where it was told) instead of the file's [plant]; None: the file's.
-
-        Returns:
-            The scene file, read and checked.
-        """
-        config = _plan_config(scene_file)
-        if method is not None:
-            config["planner"]["method"] = method
-        if plant == "none":
-            config.pop("plant", None)
-        elif plant is not None:
-            config["plant"] = {**config.get("plant", {}), "type": plant}
-            config.setdefault("servo", {"rate": DEFAULT_SERVO_RATE})
-        plan = build_plan(config, scene_file.parent, str(scene_file))  # named as `plan` does
-        plan.controller(live_obstacles=True)  # a start it refuses is refused here
-        config["planner"]["limits"] = plan.spec.limits  # a stream's jerk limits, as `plan`'s
-        return cls(config, plan.scene, plan.q0, plan.reference, plan.config)
-
-
 class Live:
     """The live page of one scene file in one viser server.
 
@@ -119,8 +62,10 @@ class Live:
         )
         self.follow = gui.add_checkbox("follow the trajectory", True)
         self.readout = gui.add_markdown("")
+        self.refusal: str | None = None  # the last refused setting, shown until a change
+        self._reverting = False  # the panel is being put back: not a change of the user's
         for handle in (self.method, self.lam, self.d_min):
-            handle.on_update(lambda _: self.rebuild())
+            handle.on_update(lambda _: None if self._reverting else self.rebuild())
         server.scene.add_grid("/grid", width=2.0, height=2.0, cell_size=0.1)
         drawing.aim_camera(server)
         visuals = visuals_of(self.config["robot"], self.scene)
@@ -169,7 +114,8 @@ class Live:
     def rebuild(self) -> None:
         """A new controller from the panel's settings, started from the arm where it is and
         as it moves (its acceleration limit holds across the change); on a start it refuses
-        (within the new d_min, say) the old one goes on."""
+        (within the new d_min, say) the old one goes on, the panel is put back to the
+        settings in force, and the refusal stays in the readout until the next change."""
         try:
             spec = self.spec()
             seed = int(spec.seed or 0)
@@ -183,14 +129,28 @@ class Live:
         except ArticulaError as exc:
             if self.controller is None:
                 raise  # the scene file's own settings do not start: nothing to show
-            self.readout.content = f"**not changed:** {exc}"
+            self.refusal = f"**not changed:** {exc}"
+            self._revert_panel()
+            self.readout.content = self.refusal
             return
+        self.refusal = None
         self.controller = controller
         self.config["planner"] |= {
             "method": spec.method,
             "lambda_weight": spec.lambda_weight,
             "d_min": spec.d_min,
         }
+
+    def _revert_panel(self) -> None:
+        """Put the panel's method, Λ and d_min back to the controller's in force."""
+        planner = self.config["planner"]
+        self._reverting = True
+        try:
+            self.method.value = planner.get("method", "baornn")
+            self.lam.value = float(planner.get("lambda_weight", 0.0))
+            self.d_min.value = float(planner.get("d_min", 0.0))
+        finally:
+            self._reverting = False
 
     def period(self) -> float:
         """One control period: obstacles from their gizmos, one planner step, the page
@@ -274,7 +234,8 @@ class Live:
                 f" contacts {self.plant.arm.contacts[-1]}"
             )
         readout += f" · planner {1e3 * elapsed:.2f} ms per {1e3 * self.dt:.0f} ms period"
-        return readout + (" · **over the period**" if elapsed > self.dt else "")
+        readout += " · **over the period**" if elapsed > self.dt else ""
+        return readout if self.refusal is None else f"{self.refusal}  \n{readout}"
 
     def _paint(
         self,
@@ -329,15 +290,6 @@ class Live:
         return self.recording.write(
             folder, self.config, self.scene, self.q0, self.dt, iterations, plant, wall_time
         )
-
-
-def _plan_config(scene_file: Path) -> dict[str, Any]:
-    """A scene file as a plan config, its file paths absolute (so a recorded run finds them)."""
-    data = load_toml(scene_file)
-    if "trajectory" not in data:
-        raise ArticulaError(f"{scene_file}: live needs a [trajectory] table (the path to follow)")
-    data.setdefault("planner", {})
-    return absolute_paths(data, scene_file.resolve().parent)
 
 
 def run_live(
