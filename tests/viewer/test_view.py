@@ -10,6 +10,7 @@ import socket
 import urllib.request
 
 import numpy as np
+import pytest
 
 from tests.viewer.conftest import free_port, keep_screenshot, open_page, robot_mask, screenshot
 
@@ -56,6 +57,21 @@ def test_a_folder_without_a_run_is_one_line_and_exit_2(tmp_path, cli):
     proc = cli("view", tmp_path, "--port", str(free_port()))
     assert proc.returncode == 2
     assert len(proc.stderr.strip().splitlines()) == 1 and "RUN_DIR" in proc.stderr
+
+
+@pytest.mark.parametrize("damage", ["missing", "truncated"])
+def test_a_run_without_its_whole_record_is_refused_in_one_line(planned_run, cli, tmp_path,
+                                                               damage):  # fmt: skip
+    run = tmp_path / "run"
+    shutil.copytree(planned_run, run)
+    record = run / "record.json"
+    if damage == "missing":
+        record.unlink()
+    else:
+        record.write_text(record.read_text()[:40])  # a write cut short
+    proc = cli("view", run, "--port", str(free_port()))
+    assert proc.returncode == 2 and "record.json" in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1
 
 
 def test_a_taken_port_is_one_line_and_exit_2(planned_run, cli):

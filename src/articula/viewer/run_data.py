@@ -17,7 +17,8 @@ from articula.experiments.plan import NAME as PLAN
 from articula.experiments.plan import build_plan
 from articula.robots.model import BUILTIN
 from articula.robots.urdf_visuals import Visual, visual_meshes
-from articula.runs.folders import CONFIG, TRACE
+from articula.runs.folders import CONFIG, RECORD, TRACE
+from articula.runs.records import read_record
 from articula.scene.obstacles import Obstacle
 from articula.scene.scene import Scene
 
@@ -228,6 +229,14 @@ def load_run(folder: Path) -> RunData:
         trace = pq.read_table(folder / TRACE).to_pydict()
     except (OSError, ValueError) as exc:
         raise RunFolderError("RUN_DIR", f"{folder} has no readable {TRACE} ({exc})") from None
+    try:  # written last: without it the run did not finish (or its folder was damaged)
+        read_record(folder)
+    except (OSError, ValueError) as exc:
+        raise RunFolderError(
+            "RUN_DIR",
+            f"{folder / RECORD} is missing or unreadable ({type(exc).__name__}): the run did not "
+            "finish; plan it again",
+        ) from None
     scene = build_plan(config, folder, str(folder / CONFIG)).scene  # errors named as `plan`
     nq = scene.robot.nq
     column = lambda *names: np.column_stack([trace[n] for n in names])  # noqa: E731
