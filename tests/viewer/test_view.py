@@ -11,7 +11,9 @@ import urllib.request
 
 import numpy as np
 import pytest
+import viser
 
+from articula.viewer.replay import ERROR_FLOOR_MM, Replay
 from tests.viewer.conftest import free_port, keep_screenshot, open_page, robot_mask, screenshot
 
 
@@ -107,3 +109,16 @@ def test_plan_live_and_view_name_a_bad_key_alike(planned_run, cli, tmp_path):
     again = cli("plan", run / "config.toml", "--out", tmp_path / "out2")
     assert view.returncode == again.returncode == 2 and view.stderr == again.stderr
     assert f"{run / 'config.toml'}: trajectory.radius" in view.stderr
+
+
+def test_the_error_is_plotted_on_a_log_axis_floored_at_a_micrometre(planned_run):
+    server = viser.ViserServer(host="127.0.0.1", port=free_port(), verbose=False)
+    try:
+        replay = Replay(server, [planned_run])
+        error = replay.plots[0]
+        assert error.scales["value"]["distr"] == 3 and error.scales["value"]["log"] == 10
+        values = error.data[1]
+        expected = np.maximum(1e3 * replay.run.error, ERROR_FLOOR_MM)  # mm, floored at 1 µm
+        np.testing.assert_allclose(values, expected)
+    finally:
+        server.stop()

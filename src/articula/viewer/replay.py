@@ -26,6 +26,7 @@ from articula.viewer.run_data import RunData, load_run, run_folders
 
 SPEEDS = ("0.25", "0.5", "1", "2", "4")
 FRAME_S = 1.0 / 30.0  # [s] between frames while playing
+ERROR_FLOOR_MM = 1e-3  # [mm] the error plot's floor on its log axis (1 µm)
 
 
 class Replay:
@@ -78,7 +79,11 @@ class Replay:
         for plot in self.plots:
             plot.remove()
         self.plots = [
-            self._plot("error [mm]", run.t, 1e3 * run.error),
+            # Log axis: the approach's 100 mm and the path's tenths of a millimetre both show
+            # (floored at 1 µm, where a log axis would lose an exact zero).
+            self._plot(
+                "error [mm], log", run.t, np.maximum(1e3 * run.error, ERROR_FLOOR_MM), log=True
+            ),
             self._plot(
                 "clearance [mm]",
                 run.t,
@@ -142,12 +147,16 @@ class Replay:
         assert self.run is not None
         return int(np.clip(np.searchsorted(self.run.t, t + 1e-9) - 1, 0, len(self.run.t) - 1))
 
-    def _plot(self, label: str, t: np.ndarray, values: np.ndarray):
-        """A small uPlot of one series against time."""
+    def _plot(self, label: str, t: np.ndarray, values: np.ndarray, log: bool = False):
+        """A small uPlot of one series against time (its value axis logarithmic with `log`)."""
+        value_scale = uplot.Scale(distr=3, log=10) if log else uplot.Scale()
         return self.server.gui.add_uplot(
             data=(t, values),
-            series=(uplot.Series(label="t [s]"), uplot.Series(label=label, stroke="#d9480f")),
-            scales={"x": uplot.Scale(time=False)},
+            series=(
+                uplot.Series(label="t [s]"),
+                uplot.Series(label=label, stroke="#d9480f", scale="value"),
+            ),
+            scales={"x": uplot.Scale(time=False), "value": value_scale},
             title=label,
             aspect=2.0,
         )
