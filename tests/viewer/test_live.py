@@ -6,7 +6,7 @@ the page renders in Chromium."""
 from __future__ import annotations
 
 import signal
-import time
+import urllib.request
 
 import numpy as np
 import pytest
@@ -107,8 +107,9 @@ def test_the_live_page_renders_in_two_tabs_and_ctrl_c_writes_the_record(
         assert robot_mask(screenshot(page)).sum() > 2000
     keep_screenshot(pages[0], "live.png", tmp_path)
     browser.close()
-    time.sleep(1.0)
-    assert proc.poll() is None  # the tabs went, the loop goes on
+    with urllib.request.urlopen(url, timeout=30) as response:  # the tabs went, it serves on
+        assert response.status == 200
+    assert proc.poll() is None
     proc.send_signal(signal.SIGINT)
     assert proc.wait(30) == 130
     run = load_run(tmp_path / "rec")

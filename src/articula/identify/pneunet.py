@@ -10,6 +10,7 @@ pressure (a pump's rating) and the valve's time constant (its datasheet's) are t
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -37,6 +38,7 @@ CONSTANTS = (
 # both, half of ten hidden actuators came out with the two swapped, at a lower cost).
 GIVEN = ("supply_pressure", "valve_tau")
 PWM_FULL = 255.0  # the valve's PWM count at full duty
+_DEFAULTS = PneuNetParams().model_dump()  # every constant a trial point does not set
 
 
 @dataclass(frozen=True)
@@ -81,7 +83,7 @@ def simulate(constants: Mapping[str, float], recording: PneuNetRecording) -> np.
     """
     # Built without validation: a trial point of the fit may bend less than the book's 90°.
     params = PneuNetParams.model_construct(
-        **(PneuNetParams().model_dump() | dict(constants) | {"pwm_period": recording.dt})
+        **(_DEFAULTS | dict(constants) | {"pwm_period": recording.dt})
     )
     plant = PneuNetBatch(params, 1)
     angle = np.empty(recording.pwm.size)
@@ -132,10 +134,7 @@ def identify_pneunet(
     measured = [{"angle": r.angle} for r in recordings]
     fit, validation, begin = fit_recordings(predict, measured, begin, CONSTANTS)
     # The given constants are not found: named with the undetermined ones.
-    fit = type(fit)(
-        fit.values, fit.standard_errors, (*fit.unidentifiable, *GIVEN), fit.cost,
-        fit.residual_sigma,
-    )  # fmt: skip
+    fit = dataclasses.replace(fit, unidentifiable=(*fit.unidentifiable, *GIVEN))
     constants = begin | fit.values
     plant = {
         "experiment": "pneunet.pid",
@@ -156,7 +155,7 @@ def _static_estimate(
     least squares (the dynamic fit, started far from it, settled in a minimum with the map
     40-60 % off in three of ten hidden actuators). Empty with fewer than two held counts."""
     duty, settled = [], []
-    top = sensor_range(PneuNetParams.model_construct(**(PneuNetParams().model_dump() | start)))[1]
+    top = sensor_range(PneuNetParams.model_construct(**(_DEFAULTS | start)))[1]
     for r in recordings:
         angle = np.radians(np.mean(r.angle[-max(r.angle.size // 4, 1) :]))
         if np.ptp(r.pwm) == 0 and r.pwm[0] > 0 and angle < 0.98 * top:  # not at the clip

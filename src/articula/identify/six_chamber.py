@@ -11,6 +11,7 @@ its product with the orifice's area shows in the flow), the geometry and the sup
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -33,6 +34,7 @@ CONSTANTS = ("youngs_modulus", "damping", "orifice_diameter")
 GIVEN = ("discharge",)  # only discharge · orifice area shows in the flow
 STEP = 1e-4  # [s] the plant's integration step (rigs/six_chamber.py's)
 RECORD_EVERY = 10  # plant steps per kept sample
+_DEFAULTS = SixChamberParams().model_dump()  # every constant a trial point does not set
 
 
 @dataclass(frozen=True)
@@ -93,7 +95,7 @@ def simulate(constants: Mapping[str, float], recording: SixChamberRecording) -> 
         The sensor's bending (x, y) at each of the recording's samples [deg], shape (n, 2).
     """
     # Built without validation: a trial point of the fit is checked by the bounds alone.
-    p = SixChamberParams.model_construct(**(SixChamberParams().model_dump() | dict(constants)))
+    p = SixChamberParams.model_construct(**(_DEFAULTS | dict(constants)))
     sensor = OrientationSensorParams(rate=1.0 / recording.dt, noise_deg=0.0)
     r = recording
     program = valve_program(p, r.side, r.gauge, r.hold, r.damping)
@@ -131,10 +133,7 @@ def identify_six_chamber(
     begin = {name: getattr(start, name) for name in (*CONSTANTS, *GIVEN)}
     measured = [{"bend_x": r.bend[:, 0], "bend_y": r.bend[:, 1]} for r in recordings]
     fit, validation, begin = fit_recordings(predict, measured, begin, CONSTANTS, hold_out_last=True)
-    fit = type(fit)(
-        fit.values, fit.standard_errors, (*fit.unidentifiable, *GIVEN), fit.cost,
-        fit.residual_sigma,
-    )  # fmt: skip
+    fit = dataclasses.replace(fit, unidentifiable=(*fit.unidentifiable, *GIVEN))
     constants = begin | fit.values
     plant = {"experiment": "softarm.damping", "actuator": start.model_dump() | constants}
     held = recordings[-1]  # the figure shows the prediction of the held-out recording

@@ -208,19 +208,21 @@ class Live:
         scene = self.controller.planner.scene
         late = elapsed > self.dt
         poses = scene.robot.link_poses(self.q)
-        frames = {name: drawing.wxyz_position(poses[name]) for name in self.frames if name in poses}
+        moves = [
+            (f, *drawing.wxyz_position(poses[n])) for n, f in self.frames.items() if n in poses
+        ]
         d_min = float(self.d_min.value)
         colours = {
             link.name: drawing.clearance_colour(float(d[i].min()), d_min)
             for i, link in enumerate(scene.robot.links)
         }
         if self.plant is not None:
-            frames |= {f"measured {name}": pose for name, pose in self.plant.link_frames().items()}
+            moves += self.plant.link_moves()
         readout = None
         if late or self.periods % READOUT_EVERY == 0:
             readout = self._readout(x, target, clearance, elapsed)
         shown = target.copy() if self.follow.value else None
-        self.painter.post(lambda: self._paint(frames, colours, readout, shown))
+        self.painter.post(lambda: self._paint(moves, colours, readout, shown))
 
     def _readout(self, x: np.ndarray, target: np.ndarray, clearance: float, elapsed: float) -> str:
         """The panel's line: clearance, error, the planner's time (and the measured arm's)."""
@@ -239,20 +241,17 @@ class Live:
 
     def _paint(
         self,
-        frames: dict[str, tuple[np.ndarray, np.ndarray]],
+        moves: list[tuple[viser.FrameHandle, np.ndarray, np.ndarray]],
         colours: dict[str, tuple[int, int, int]],
         readout: str | None,
         target: np.ndarray | None,
     ) -> None:
-        """On the painter's thread: move the arm (and the target it follows), recolour the
-        links whose colour changed since the last picture, write the readout."""
+        """On the painter's thread: move the arm's link frames (moves: frame, wxyz, position),
+        and the target it follows, recolour the links whose colour changed since the last
+        picture, write the readout."""
         if target is not None:
             self.target.position = target
-        for name, (wxyz, position) in frames.items():
-            if name in self.frames:
-                frame = self.frames[name]
-            else:  # the measured arm's
-                frame = self.plant.frames[name.removeprefix("measured ")]
+        for frame, wxyz, position in moves:
             frame.wxyz, frame.position = wxyz, position
         for name, colour in colours.items():
             if self.colours.get(name) != colour:  # only what changed goes out

@@ -73,11 +73,11 @@ class LivePlant:
         """
         return self.scene.clearances(self.q, 0.0)[0] if self.scene.obstacles else np.inf
 
-    def link_frames(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-        """The measured arm's link poses as the page takes them.
+    def link_moves(self) -> list[tuple[viser.FrameHandle, np.ndarray, np.ndarray]]:
+        """Where the measured arm's link frames go on the page.
 
         Returns:
-            Link name -> (wxyz quaternion, position [m]).
+            (frame, wxyz quaternion, position [m]) for each link drawn.
         """
         poses = self.scene.robot.link_poses(self.q)
-        return {name: drawing.wxyz_position(poses[name]) for name in self.frames if name in poses}
+        return [(f, *drawing.wxyz_position(poses[n])) for n, f in self.frames.items() if n in poses]
