@@ -62,3 +62,11 @@ def test_a_recording_with_the_load_motor_driven_is_refused():
                "v2": [0.0] * 199 + [0.5]}  # fmt: skip
     with pytest.raises(ConfigError, match="v2"):
         MotorRecording.from_columns(columns, "rec")
+
+
+def test_a_recording_with_a_nan_is_refused_by_name():
+    t = [k * 1e-3 for k in range(200)]
+    columns = {"t": t, "v1": [1.0] * 200, "i_meas": [0.1] * 199 + [float("nan")],
+               "omega_meas": [0.0] * 200}  # fmt: skip
+    with pytest.raises(ConfigError, match="i_meas has NaN"):
+        MotorRecording.from_columns(columns, "rec")

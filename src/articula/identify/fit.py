@@ -230,8 +230,8 @@ def _noise(signals: Sequence[np.ndarray]) -> float:
 def sample_period(
     columns: Mapping[str, np.ndarray], needed: Sequence[str], at_least: int, where: str, what: str
 ) -> float:
-    """A recording's sample period, once it is checked to have the `needed` columns, at least
-    `at_least` samples and evenly spaced times (a lossy line leaves gaps).
+    """A recording's sample period, once it is checked to have the `needed` columns, finite, at
+    least `at_least` samples and evenly spaced times (a lossy line leaves gaps).
 
     Args:
         columns: the recording's trace columns, name -> values (t [s] among them).
@@ -246,6 +246,9 @@ def sample_period(
     missing = [c for c in ("t", *needed) if c not in columns]
     if missing:
         raise ConfigError(where, f"not a {what} recording: no {', '.join(missing)} column")
+    for name in ("t", *needed):
+        if not np.all(np.isfinite(np.asarray(columns[name], dtype=float))):
+            raise ConfigError(where, f"{name} has NaN or infinite samples: record again")
     t = np.asarray(columns["t"], dtype=float)
     if t.size < at_least:
         raise ConfigError(where, f"{t.size} samples: a fit needs at least {at_least}")
