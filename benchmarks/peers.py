@@ -37,6 +37,13 @@ call):
                               far_min_distance_m), from a second round-robin race of all
                               controllers on all those scenes, far_steps periods
   <name>_per_far_obstacle_us  least-squares slope of those medians over the count
+  <name>_near_step_us         the same with 0, 1, 2, 4, 8 near obstacles: half-size rock
+                              copies within the arm's reach, 0.3-0.6 m from every link over
+                              every controller's motion of the main race (near_distance_m:
+                              the least and largest such distance), outside the detection
+                              distance: a cell's objects that no method needs to avoid
+  <name>_per_near_obstacle_us least-squares slope of those medians over the count (issue 31's
+                              target: ≤ 10 µs for qp and improved)
 mink checks its pairs one by one below 16 pairs (the two obstacles make 14) and with a
 vectorized bounding-sphere broad phase from 16 on, so its cost steps up from 0 to 1 far
 obstacle and is nearly flat after.
@@ -68,6 +75,8 @@ SCENE = "circle_two_obstacles.toml"
 INFLUENCE = 0.15  # [m] articula's qp influence distance = mink's collision_detection_distance
 FAR_COUNTS = (0, 1, 2, 4, 8)
 FAR_RADIUS = 2.0  # [m] from the base axis; the iiwa14 reaches about 1.3 m
+NEAR_COUNTS = FAR_COUNTS
+NEAR_BAND = (0.3, 0.6)  # [m] from every link over the main race's motions
 FAR_STEPS = 300  # periods of the far-obstacle race (fewer when --steps is smaller)
 WARMUP = 5  # periods run (and discarded) by each controller before the race: JIT, caches
 NAMES = ("qp", "improved", "mink")
@@ -121,13 +130,18 @@ def measure(steps: int) -> dict[str, Any]:
     far_scenes = {n: with_far_obstacles(scene, n) for n in FAR_COUNTS}
     far = {n: lanes(s) for n, s in far_scenes.items()}
     _race([lane for n in FAR_COUNTS for lane in far[n]], reference[:far_steps])
+    motion = [q for lane in main for q in lane.qs[::10]]
+    near_scenes, near_distance = with_near_obstacles(scene, max(NEAR_COUNTS), motion)
+    near = {n: lanes(near_scenes[n]) for n in NEAR_COUNTS}
+    _race([lane for n in NEAR_COUNTS for lane in near[n]], reference[:far_steps])
 
     settle = min(5.0, steps * dt / 2)
     settled = np.arange(steps) * dt >= settle
     m: dict[str, Any] = {"steps": steps, "far_steps": far_steps, "dt_s": dt, "d_min_m": d_min,
                          "detection_m": INFLUENCE, "settle_s": settle,
                          "mink_matched_gain": gain,
-                         "far_counts": list(FAR_COUNTS)}  # fmt: skip
+                         "far_counts": list(FAR_COUNTS), "near_counts": list(NEAR_COUNTS),
+                         "near_distance_m": near_distance}  # fmt: skip
     for lane in main:
         q = np.array(lane.qs)
         x = np.array([scene.robot.ee_position(qn) for qn in q])
@@ -143,6 +157,9 @@ def measure(steps: int) -> dict[str, Any]:
         medians = [statistics.median(far[n][k].times_ns) / 1e3 for n in FAR_COUNTS]
         m[f"{name}_far_step_us"] = medians
         m[f"{name}_per_far_obstacle_us"] = float(np.polyfit(counts, medians, 1)[0])
+        medians = [statistics.median(near[n][k].times_ns) / 1e3 for n in NEAR_COUNTS]
+        m[f"{name}_near_step_us"] = medians
+        m[f"{name}_per_near_obstacle_us"] = float(np.polyfit(counts, medians, 1)[0])
     m["far_min_distance_m"] = far_clearance(far_scenes[max(FAR_COUNTS)], scene, main)
     return m
 
@@ -195,6 +212,38 @@ def with_far_obstacles(scene: Scene, count: int) -> Scene:
                  scene.self_pair_names)  # fmt: skip
 
 
+def with_near_obstacles(
+    scene: Scene, count: int, motion: Sequence[np.ndarray]
+) -> tuple[dict[int, Scene], list[float]]:
+    """`scene` with the first n of `count` half-size rock copies (n in NEAR_COUNTS), each
+    NEAR_BAND from every link over `motion`, centres 0.3 m apart, placed by a seeded
+    search within 1.2 m of the base; and the least and largest of their distances [m]."""
+    rock = next(o for o in scene.obstacles if o.name == "rock")
+    small = tuple(convex_hull(0.5 * part.vertices, "near rock") for part in rock.parts)
+    rng = np.random.default_rng(0)
+    placed: list[Obstacle] = []
+    distances: list[float] = []
+    while len(placed) < count:
+        pose = np.eye(4)
+        pose[:3, 3] = rng.uniform([-1.2, -1.2, 0.0], [1.2, 1.2, 1.4])
+        if np.linalg.norm(pose[:3, 3] - [0.0, 0.0, 0.36]) > 1.2 or any(
+            np.linalg.norm(pose[:3, 3] - o.pose[:3, 3]) < 0.3 for o in placed
+        ):
+            continue
+        candidate = Obstacle(f"near{len(placed)}", small, pose)
+        alone = Scene(scene.robot, (candidate,))
+        closest = min(alone.min_distance(q) for q in motion)
+        if NEAR_BAND[0] <= closest <= NEAR_BAND[1]:
+            placed.append(candidate)
+            distances.append(closest)
+    scenes = {}
+    for n in NEAR_COUNTS:
+        obstacles = (*scene.obstacles, *placed[:n])
+        scenes[n] = Scene(scene.robot, obstacles, scene.broadphase, scene.metric,
+                          scene.self_pair_names)  # fmt: skip
+    return scenes, [min(distances, default=0.0), max(distances, default=0.0)]
+
+
 def far_clearance(far_scene: Scene, scene: Scene, lanes: Sequence[Lane]) -> float:
     """Smallest distance [m] from any link to any far obstacle over every lane's motion
     (every fifth period)."""
@@ -210,22 +259,26 @@ def table(m: dict[str, Any]) -> tuple[str, list[str], list[list[str]]]:
                         ("mink_matched", f"mink {m['mink_matched_gain']:.1e}")):  # fmt: skip
         ratio = f"{m[f'{name}_step_us'] / m['mink_step_us']:.2f}"
         slope = m.get(f"{name}_per_far_obstacle_us")
+        near = m.get(f"{name}_per_near_obstacle_us")
         rows.append(
             [
                 label,
                 f"{m[f'{name}_step_us']:.0f}",
                 ratio,
                 "" if slope is None else f"{slope:+.1f}",
+                "" if near is None else f"{near:+.1f}",
                 f"{1e6 * m[f'{name}_rms_m']:.3g}",
                 f"{1e3 * m[f'{name}_min_clearance_m']:.2f}",
             ]
         )
     title = (
         f"one 10 ms period, median of {m['steps']} (far obstacles {m['far_counts']}: "
-        f"{m['far_steps']} periods, ≥ {m['far_min_distance_m']:.2f} m away); RMS after "
+        f"{m['far_steps']} periods, ≥ {m['far_min_distance_m']:.2f} m away; near "
+        f"{m['near_distance_m'][0]:.2f}-{m['near_distance_m'][1]:.2f} m); RMS after "
         f"{m['settle_s']:g} s"
     )
-    columns = ["controller", "µs/period", "× mink", "µs/far obst.", "RMS µm", "clear. mm"]
+    columns = ["controller", "µs/period", "× mink", "µs/far obst.", "µs/near obst.", "RMS µm",
+               "clear. mm"]  # fmt: skip
     return title, columns, rows
 
 

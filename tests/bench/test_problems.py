@@ -11,8 +11,11 @@ import pytest
 import tomli_w
 
 from articula.bench import problems
+from articula.loops.tracking import track
 from articula.planning.config import TrajectorySpec, make_targets
+from articula.planning.velocity_ik import VelocityIk
 from articula.scene.config import build_scene, load_scene_spec
+from articula.scene.scene import Scene
 
 IIWA = {"builtin": "iiwa14"}
 
@@ -71,3 +74,18 @@ def test_a_problem_file_runs_with_articula_plan(generated, tmp_path, cli, one_js
     assert proc.returncode == 0, proc.stderr
     metrics = one_json(proc.stdout)["metrics"]
     assert metrics["min_clearance"] > 0 and metrics["max_speed_ratio"] <= 1.0 + 1e-9
+
+
+def test_tight_obstacles_sit_2_to_5_cm_from_the_obstacle_free_motion(tmp_path):
+    for index in range(3):
+        problem = problems.generate(IIWA, 3, index, "tight")
+        scene, q0, targets = _scene(problem, tmp_path)
+        duration = problem.config["planner"]["duration"]
+        # The obstacle-free motion again: damped least squares along the path.
+        planner = VelocityIk(Scene(scene.robot, []), "dls", problems.DT)
+        motion = track(planner, targets, q0, problems.DT, duration, 10**6).q
+        assert 2 <= len(scene.obstacles) <= 4
+        for obstacle in scene.obstacles:
+            alone = Scene(scene.robot, [obstacle])
+            closest = min(alone.clearances(q)[0] for q in motion)
+            assert problems.TIGHT_GAP[0] - 1e-9 <= closest <= problems.TIGHT_GAP[1] + 1e-9

@@ -73,6 +73,20 @@ def test_mink_runs_the_same_problems(tmp_path):
     assert summary["methods"]["qp"]["vs_best_mink"] == pytest.approx(
         summary["methods"]["qp"]["success_rate"] - best
     )
+    qp, mink = summary["methods"]["qp"], summary["methods"]["mink"]
+    assert qp["step_time_vs_mink"] == pytest.approx(qp["mean_step_us"] / mink["mean_step_us"])
+
+
+def test_the_tight_class_is_its_own_suite(tmp_path, cli, one_json):
+    out = tmp_path / "suite"
+    args = ("bench", "suite", "--problems", "2", "--methods", "qp", "--workers", "1",
+            "--out", out, "--json")  # fmt: skip
+    tight = one_json(cli(*args, "--class", "tight").stdout)
+    assert tight["class"] == "tight"
+    first = (out / "problems" / "000" / "scene.toml").read_text()
+    standard = one_json(cli(*args).stdout)  # another class: every problem again, regenerated
+    assert standard["class"] == "standard"
+    assert (out / "problems" / "000" / "scene.toml").read_text() != first
 
 
 @pytest.mark.parametrize(
@@ -81,6 +95,7 @@ def test_mink_runs_the_same_problems(tmp_path):
         (("--methods", "qp,warp"), "--methods"),
         (("--robot", "no_such_arm.urdf"), "--robot"),
         (("--problems", "0"), "--problems"),
+        (("--class", "loose"), "--class"),
     ],
 )
 def test_bad_options_are_one_line_and_exit_2(tmp_path, cli, options, named):

@@ -76,10 +76,29 @@ def test_short_antennae_refine_what_the_long_ones_overshoot(objective):
         assert errors[0.25] < 0.7 * errors[1.0], (seed, errors)
 
 
+def test_clear_of_the_yield_distance_a_period_never_raises_the_task_error(objective):
+    # Change 5; with yield_distance = inf (the book's acceptance) the penalty does raise it.
+    raised = {}
+    for yield_distance in (0.03, np.inf):
+        params = PARAMS.model_copy(update={"yield_distance": yield_distance})
+        planner = ImprovedBaornn(objective, params, np.random.default_rng(2))
+        q, raised[yield_distance] = np.zeros(ROBOT.nq), []
+        for n in range(300):
+            x_ref = CIRCLE(DT * n)
+            e_start = objective.tracking_error(q, x_ref)
+            clear = objective.scene.clearances(q)[0] >= 0.03  # every period here (≥ 66 mm)
+            q = planner.step(q, x_ref, DT * n)
+            if clear:
+                raised[yield_distance].append(objective.tracking_error(q, x_ref) > e_start)
+    assert len(raised[0.03]) == 300 and not any(raised[0.03])
+    assert any(raised[np.inf])
+
+
 @pytest.mark.parametrize(
     ("kwargs", "field"),
     [({"pairs": 0}, "ImprovedParams.pairs"), ({"c1": -1.0}, "ImprovedParams.c1"),
-     ({"short_antenna": 0.0}, "ImprovedParams.short_antenna")],
+     ({"short_antenna": 0.0}, "ImprovedParams.short_antenna"),
+     ({"yield_distance": -0.01}, "ImprovedParams.yield_distance")],
 )  # fmt: skip
 def test_bad_params_name_the_class_and_field(kwargs, field):
     with pytest.raises(ConfigError) as exc:

@@ -47,12 +47,14 @@ def test_compiled_baornn_follows_the_python_loop():
 
 def test_compiled_improved_variant_follows_its_python_loop():
     # The same draws and steps; the two distance codes differ by ~1e-7 m, which a continuous
-    # gradient estimate carries into q at ~1e-9 rad over the first steps.
+    # gradient estimate carries into q at ~1e-9 rad over the first steps and ~2e-6 rad over
+    # twenty (a different acceptance would differ by the antennae, ~1e-2 rad).
     params = ImprovedParams(c1=0.3, c2=0.5, pairs=3, iterations_per_step=2)
     runs, planners = _both_paths(lambda objective, rng: ImprovedBaornn(objective, params, rng), 20)
     for planner in planners:
         assert planner.iterations == 40
-    assert np.allclose(runs[0], runs[1], atol=1e-6)
+    assert np.allclose(runs[0][:4], runs[1][:4], atol=1e-8)
+    assert np.allclose(runs[0], runs[1], atol=1e-5)
 
 
 def test_a_point_closer_to_itself_than_the_margin_is_outside_omega_on_every_path():

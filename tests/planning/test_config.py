@@ -30,7 +30,8 @@ BASELINE = {"dt": 0.02, "d_min": 0.003, "gain": 12.0, "influence": 0.2, "safety"
     ("method", "kind"), [("baornn", Baornn), ("baornn-improved", ImprovedBaornn)]
 )
 def test_make_planner_builds_a_beetle_search_on_the_spec_objective(method, kind):
-    planner = make_planner(PlannerSpec(method=method, pairs=5, **BEETLE), SCENE, seed=0)
+    spec = PlannerSpec(method=method, pairs=5, short_antenna=0.5, yield_distance=0.04, **BEETLE)
+    planner = make_planner(spec, SCENE, seed=0)
     assert type(planner) is kind
     assert planner.scene is SCENE
     objective = planner.objective
@@ -38,7 +39,7 @@ def test_make_planner_builds_a_beetle_search_on_the_spec_objective(method, kind)
     params = planner.params
     assert (params.c1, params.c2, params.iterations_per_step) == (0.2, 0.7, 4)
     if method == "baornn-improved":
-        assert params.pairs == 5
+        assert (params.pairs, params.short_antenna, params.yield_distance) == (5, 0.5, 0.04)
 
 
 def test_make_planner_builds_the_qp_baseline():

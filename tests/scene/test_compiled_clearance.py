@@ -9,6 +9,7 @@ import pytest
 from articula.geometry.poses import pose
 from articula.geometry.shapes import box, capsule, cylinder, sphere
 from articula.robots import RobotModel
+from articula.robots.sweep import joint_sweep
 from articula.scene import Obstacle, Scene
 from articula.scene.compiled_clearance import CompiledClearance, _evaluate
 from tests.scene.helpers import book_scene
@@ -111,18 +112,24 @@ def test_self_pairs_agree_with_coal_and_stay_apart_from_obstacles():
 def test_near_pairs_keep_every_pair_that_can_be_the_minimum_in_the_box():
     far = [Obstacle(f"far{k}", (sphere(0.1),), pose([2.0 * np.cos(k), 2.0 * np.sin(k), 0.5]))
            for k in range(4)]  # fmt: skip
+    within_reach = [Obstacle(f"reach{k}", (sphere(0.05),), pose([0.9 * np.cos(k), 0.9 * np.sin(k),
+                                                                0.4 + 0.1 * k]))
+                    for k in range(4)]  # fmt: skip
     near = Obstacle("near", (box((0.1, 0.2, 0.15)),), pose([0.3, 0.3, 0.6], [0.3, -0.2, 0.5]))
-    scene = Scene(ROBOT, [near, *far])
+    scene = Scene(ROBOT, [near, *far, *within_reach])
     compiled = CompiledClearance.build(scene)
     rng = np.random.default_rng(8)
-    dropped = 0
+    dropped = {"reach": 0, "sweep": 0}
     for centre in rng.uniform(0.8 * ROBOT.lower, 0.8 * ROBOT.upper, (30, ROBOT.nq)):
         width = 0.015  # one 10 ms period at 1.5 rad/s
         lower, upper = centre - width, centre + width
-        kept = compiled.near_pairs(compiled.pairs, (lower, upper))
-        dropped += len(compiled.pairs) - len(kept)
-        for q in rng.uniform(lower, upper, (5, ROBOT.nq)):
-            every = _evaluate(q, compiled.inputs(), compiled.static_min)[0]
-            near_only = _evaluate(q, compiled.inputs(kept), compiled.static_min)[0]
-            assert near_only == pytest.approx(every, abs=1e-9)
-    assert dropped >= 30 * 4 * 7  # the far spheres' pairs, at least, left every box
+        for name, sweep in (("reach", None), ("sweep", joint_sweep(ROBOT))):
+            kept = compiled.near_pairs(compiled.pairs, (lower, upper), sweep)
+            dropped[name] += len(compiled.pairs) - len(kept)
+            for q in rng.uniform(lower, upper, (5, ROBOT.nq)):
+                every = _evaluate(q, compiled.inputs(), compiled.static_min)[0]
+                near_only = _evaluate(q, compiled.inputs(kept), compiled.static_min)[0]
+                assert near_only == pytest.approx(every, abs=1e-9)
+    assert dropped["reach"] >= 30 * 4 * 7  # the far spheres' pairs, at least, left every box
+    # Per joint, the box's distal joints count for what they move: more pairs left out.
+    assert dropped["sweep"] > 1.2 * dropped["reach"]

@@ -100,18 +100,14 @@ def test_the_twin_touches_nothing_within_its_effort_limits(twin_runs, scene, met
     assert clearance > 0.0 and m["plant_min_clearance"] > 0.0
 
 
-STALLS = pytest.mark.xfail(
-    strict=True,
-    reason="with the jerk limits a servo stream needs, baornn-improved reaches the book circle "
-    "with joint 3 at its limit, where the penalty Λ/d holds the tool ~20 mm short beside the "
-    "bracket: 9.2 mm RMS measured (docs/deviations.md, jerk limits)",
-)
-
-
 @pytest.mark.parametrize(
     ("scene", "method"),
-    [("circle", "qp"), ("panda", "qp"), pytest.param("circle", "baornn-improved", marks=STALLS),
-     ("panda", "baornn-improved")],
-)  # fmt: skip
+    [
+        ("circle", "qp"),
+        ("panda", "qp"),
+        ("circle", "baornn-improved"),
+        ("panda", "baornn-improved"),
+    ],
+)
 def test_the_twin_tracks_within_2_mm(twin_runs, scene, method):
     assert twin_runs(scene, method)[0]["plant_rms_error"] <= 0.002

@@ -14,7 +14,9 @@ Problem i of seed S draws everything from numpy.random.default_rng([S, i]):
    sphere) from every point of the path.
 
 Obstacles near the links' swept volume force the redundancy to be used; the path itself stays
-free, so a controller that keeps clear can still track it.
+free, so a controller that keeps clear can still track it. The "tight" class (issue 31) puts
+2-4 obstacles each TIGHT_GAP (2-5 cm) from the links over the whole obstacle-free motion: that
+motion stays clear, but every method's dampers or penalty act on it throughout.
 """
 
 from __future__ import annotations
@@ -53,6 +55,8 @@ START_SELF_CLEARANCE = 0.01  # [m] between checked links at q0 (the Panda's wris
 # about 2.2 cm apart in most poses)
 PATH_CLEARANCE = 0.06  # [m] from every obstacle's bounding sphere to the path
 REACH_RMS = 0.0005  # [m] obstacle-free DLS tracking that shows a path reachable
+TIGHT_GAP = (0.02, 0.05)  # [m] the tight class: each obstacle's clearance from the motion
+CLASSES = ("standard", "tight")
 ATTEMPTS = 100  # draws of a start, path or obstacle before the problem is given up
 # The suite's common settings, and BAORNN's. Its penalty Λ/d (Eq. 1.11, β = 1) pulls harder
 # than the tracking term (|∂(Λ/d)/∂d| > 1) within √Λ of an obstacle, so Λ sets how near a
@@ -93,7 +97,9 @@ class Problem:
     path_kind: str
 
 
-def generate(robot_table: dict[str, Any], seed: int, index: int) -> Problem:
+def generate(
+    robot_table: dict[str, Any], seed: int, index: int, problem_class: str = "standard"
+) -> Problem:
     """Problem `index` of the suite of `seed` for the robot of a [robot] table (absolute paths).
 
     Raises InfeasibleError when no start, path or obstacle placement is found in ATTEMPTS
@@ -103,6 +109,7 @@ def generate(robot_table: dict[str, Any], seed: int, index: int) -> Problem:
         robot_table: a [robot] table with absolute paths; its q0, if any, is replaced.
         seed: the suite's seed.
         index: the problem's index; it draws from default_rng([seed, index]).
+        problem_class: "standard", or "tight" (obstacles TIGHT_GAP from the links).
 
     Returns:
         The problem.
@@ -119,7 +126,8 @@ def generate(robot_table: dict[str, Any], seed: int, index: int) -> Problem:
         if motion is None:
             continue
         reference = np.array([targets(t).position for t in np.arange(0.0, duration, DT)])
-        obstacles, meshes = _obstacles(robot, q0, motion, reference, rng)
+        tight = problem_class == "tight"
+        obstacles, meshes = _obstacles(robot, q0, motion, reference, rng, tight)
         if obstacles is None:
             continue
         planner = {**PLANNER, "duration": duration, "seed": seed}
@@ -200,12 +208,14 @@ def _obstacles(
     motion: np.ndarray,
     reference: np.ndarray,
     rng: np.random.Generator,
+    tight: bool,
 ) -> tuple[list[dict[str, Any]] | None, dict[str, trimesh.Trimesh]]:
-    """1-4 obstacles beside the motion's links, as [[obstacles]] tables and mesh files; None
-    when one cannot be placed."""
+    """1-4 obstacles beside the motion's links (tight: 2-4, each TIGHT_GAP from them over the
+    whole motion), as [[obstacles]] tables and mesh files; None when one cannot be placed."""
     tables, meshes, placed = [], {}, []
     links = [link for link in robot.links if robot.model.frames[link.frame_id].parentJoint != 0]
-    for k in range(int(rng.integers(1, 5))):
+    gap = TIGHT_GAP if tight else (-0.02, 0.05)  # [m] from the chosen surface point
+    for k in range(int(rng.integers(2 if tight else 1, 5))):
         kind = ("rock", "box", "sphere", "capsule")[int(rng.integers(4))]
         for _ in range(ATTEMPTS):
             shape, table, mesh = _shape(kind, float(rng.uniform(0.03, 0.08)), rng)
@@ -219,12 +229,14 @@ def _obstacles(
             out = surface - world.mean(axis=0)
             out = out / max(np.linalg.norm(out), 1e-9) + 0.5 * _unit(rng)
             extent = float(np.max(np.linalg.norm(shape.vertices, axis=1)))
-            centre = surface + out / np.linalg.norm(out) * (extent + rng.uniform(-0.02, 0.05))
+            centre = surface + out / np.linalg.norm(out) * (extent + rng.uniform(*gap))
             if np.min(np.linalg.norm(reference - centre, axis=1)) - extent < PATH_CLEARANCE:
                 continue
             rpy = Rotation.random(random_state=rng).as_euler("xyz")
             obstacle = Obstacle(f"{kind}{k}", (shape,), pose(centre, rpy))
             if Scene(robot, [*placed, obstacle]).clearances(q0)[0] <= START_CLEARANCE:
+                continue
+            if tight and not _within_gap(Scene(robot, [obstacle]), motion):
                 continue
             placed.append(obstacle)
             name = f"{kind}{k}"
@@ -236,6 +248,12 @@ def _obstacles(
         else:
             return None, {}
     return tables, meshes
+
+
+def _within_gap(scene: Scene, motion: np.ndarray) -> bool:
+    """Whether the scene's one obstacle is within TIGHT_GAP of the links over the motion."""
+    closest = min(scene.clearances(q)[0] for q in motion)
+    return TIGHT_GAP[0] <= closest <= TIGHT_GAP[1]
 
 
 def _shape(

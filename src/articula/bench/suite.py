@@ -30,7 +30,7 @@ import pyarrow as pa
 import tomli_w
 
 from articula.bench.problems import D_MIN, DT, INFLUENCE, SETTLE, generate
-from articula.errors import ArticulaError
+from articula.errors import ArticulaError, ConfigError
 from articula.experiments.plan import PlanSetup, build_plan
 from articula.planning.config import METHODS
 from articula.runs import records
@@ -59,6 +59,32 @@ def peers_missing() -> str | None:
     return None
 
 
+def choose_methods(methods: str | None, missing: str | None) -> list[str]:
+    """The methods of --methods: comma-separated names, or None for every articula method and,
+    when mink can run, both peers.
+
+    Args:
+        methods: the option's value, or None.
+        missing: why mink cannot run (peers_missing), or None.
+
+    Returns:
+        The chosen methods, in the order given.
+
+    Raises:
+        ConfigError: naming --methods, for an unknown or empty list or a peer that cannot run.
+    """
+    if methods is None:
+        return list(ARTICULA_METHODS) + ([] if missing else list(PEER_METHODS))
+    chosen = [m.strip() for m in methods.split(",") if m.strip()]
+    unknown = [m for m in chosen if m not in ARTICULA_METHODS + PEER_METHODS]
+    if unknown or not chosen:
+        known = ", ".join(ARTICULA_METHODS + PEER_METHODS)
+        raise ConfigError("--methods", f"unknown {unknown or 'none given'}; choose from {known}")
+    if missing and any(m in PEER_METHODS for m in chosen):
+        raise ConfigError("--methods", f"mink cannot run: {missing}")
+    return chosen
+
+
 def run_suite(
     robot: dict[str, Any],
     problems: int,
@@ -69,6 +95,7 @@ def run_suite(
     dask: str | None = None,
     force: bool = False,
     progress: Callable[[int, int], None] | None = None,
+    problem_class: str = "standard",
 ) -> dict[str, Any]:
     """Generate and run `problems` problems into `out`; returns the summary (also written to
     summary.json, beside results.parquet: one row per problem and method).
@@ -84,17 +111,19 @@ def run_suite(
         dask: None, "local" or "tcp://HOST:PORT" of a Dask scheduler (as for sweeps).
         force: write into an `out` holding files articula did not write.
         progress: called with (problems done, problems), or None.
+        problem_class: the problems' class (bench.problems.CLASSES): "standard" or "tight".
 
     Returns:
         The summary (summarize), as written to summary.json.
     """
     check_backend(dask)
-    key = _suite_key(robot, seed, methods)
+    key = _suite_key(robot, seed, methods, problem_class)
     tasks = [
         {
             "robot": robot,
             "seed": seed,
             "index": i,
+            "class": problem_class,
             "methods": list(methods),
             "key": key,
             "folder": str(out / PROBLEMS / f"{i:03d}"),
@@ -113,14 +142,15 @@ def run_suite(
         rows = [row for i in sorted(done) for row in done[i]]
         table = pa.Table.from_pylist([{k: v for k, v in r.items() if k != "step_us"} for r in rows])
         records.write_table(out / RESULTS, table)
-        summary = summarize(rows, methods, robot, seed, problems)
+        summary = summarize(rows, methods, robot, seed, problems) | {"class": problem_class}
         records.atomic_write(out / SUMMARY, (json.dumps(summary, indent=2) + "\n").encode())
     return summary
 
 
-def _suite_key(robot: dict[str, Any], seed: int, methods: Sequence[str]) -> str:
+def _suite_key(robot: dict[str, Any], seed: int, methods: Sequence[str], problem_class: str) -> str:
     """What a finished problem's results depend on, hashed."""
-    text = json.dumps({"robot": robot, "seed": seed, "methods": list(methods)}, sort_keys=True)
+    suite = {"robot": robot, "seed": seed, "methods": list(methods), "class": problem_class}
+    text = json.dumps(suite, sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -137,15 +167,15 @@ def solve_problem(task: Mapping[str, Any]) -> tuple[int, list[dict[str, Any]]]:
     """Generate problem task["index"], write its folder, run every method; (index, rows).
 
     Args:
-        task: the problem's robot table, seed, index, methods, key (the suite's hash) and
-            folder.
+        task: the problem's robot table, seed, index, class, methods, key (the suite's hash)
+            and folder.
 
     Returns:
         The index and one row per method: problem, method, path, obstacles, success,
         failure, message, metrics (none after an error) and step_us (step times [µs]).
     """
     folder = Path(task["folder"])
-    problem = generate(task["robot"], task["seed"], task["index"])
+    problem = generate(task["robot"], task["seed"], task["index"], task.get("class", "standard"))
     records.make_folder(folder)
     for name, mesh in problem.meshes.items():
         records.atomic_write(folder / name, mesh.export(file_type="stl"))
@@ -235,9 +265,9 @@ def summarize(
     seed: int,
     problems: int,
 ) -> dict[str, Any]:
-    """Per method: success rate, failures by class, median and p99 step time over all its
-    periods, median RMS error and the smallest clearance; and each articula method's success
-    rate less the better mink's.
+    """Per method: success rate, failures by class, mean, median and p99 step time over all
+    its periods, median RMS error and the smallest clearance; and each articula method's
+    success rate less the better mink's and its mean step time over mink's (default gain).
 
     Args:
         rows: the rows of every problem and method (solve_problem), with their step_us.
@@ -248,8 +278,8 @@ def summarize(
 
     Returns:
         The JSON-ready summary: robot, seed, problems, success_rms_m [m], settle_s [s], the
-        statistics of each method under "methods" and, when a peer ran,
-        best_mink_success_rate.
+        statistics of each method under "methods" (step times [µs]) and, when a peer ran,
+        best_mink_success_rate, and per articula method vs_best_mink and step_time_vs_mink.
     """
     out: dict[str, Any] = {
         "robot": dict(robot),
@@ -267,6 +297,7 @@ def summarize(
             "success_rate": sum(r["success"] for r in mine) / max(len(mine), 1),
             "successes": sum(r["success"] for r in mine),
             "failures": {f: sum(r["failure"] == f for r in mine) for f in FAILURES},
+            "mean_step_us": statistics.fmean(times) if times else None,
             "median_step_us": statistics.median(times) if times else None,
             "p99_step_us": float(np.percentile(times, 99)) if times else None,
             "median_rms_error_m": statistics.median(r["rms_error"] for r in ran) if ran else None,
@@ -276,9 +307,11 @@ def summarize(
     if peers:
         best = max(peers)
         out["best_mink_success_rate"] = best
+        peer = out["methods"].get("mink") or out["methods"][PEER_METHODS[1]]
         for method in ARTICULA_METHODS:
             if method in out["methods"]:
-                out["methods"][method]["vs_best_mink"] = (
-                    out["methods"][method]["success_rate"] - best
-                )
+                mine = out["methods"][method]
+                mine["vs_best_mink"] = mine["success_rate"] - best
+                if mine["mean_step_us"] is not None and peer["mean_step_us"]:
+                    mine["step_time_vs_mink"] = mine["mean_step_us"] / peer["mean_step_us"]
     return out

@@ -36,6 +36,9 @@ def suite(
     ] = "iiwa14",
     problems: Annotated[int, typer.Option(min=1, max=10_000, help="Generated problems.")] = 100,
     seed: Annotated[int, typer.Option(min=0, help="Seed of the problems.")] = 0,
+    problem_class: Annotated[
+        str, typer.Option("--class", help="standard, or tight: obstacles 2-5 cm from the links.")
+    ] = "standard",
     methods: Annotated[
         str | None,
         typer.Option(
@@ -54,23 +57,15 @@ def suite(
     \b
     Example: articula bench suite --robot iiwa14 --problems 100 --out runs/suite --json
     """
-    from articula.bench.suite import ARTICULA_METHODS, PEER_METHODS, peers_missing, run_suite
+    from articula.bench.problems import CLASSES
+    from articula.bench.suite import choose_methods, peers_missing, run_suite
     from articula.errors import ConfigError
     from articula.runs.folders import check_out
 
+    if problem_class not in CLASSES:
+        raise ConfigError("--class", f"unknown {problem_class!r}; choose from {CLASSES}")
     missing = peers_missing()
-    if methods is None:
-        chosen = list(ARTICULA_METHODS) + ([] if missing else list(PEER_METHODS))
-    else:
-        chosen = [m.strip() for m in methods.split(",") if m.strip()]
-        unknown = [m for m in chosen if m not in ARTICULA_METHODS + PEER_METHODS]
-        if unknown or not chosen:
-            known = ", ".join(ARTICULA_METHODS + PEER_METHODS)
-            raise ConfigError(
-                "--methods", f"unknown {unknown or 'none given'}; choose from {known}"
-            )
-        if missing and any(m in PEER_METHODS for m in chosen):
-            raise ConfigError("--methods", f"mink cannot run: {missing}")
+    chosen = choose_methods(methods, missing)
     table = robot_table(robot)
     check_out(out_dir, "suite", force)
     with progress_bar(as_json) as bar:
@@ -85,6 +80,7 @@ def suite(
             dask=dask,
             force=force,
             progress=lambda done, total: bar.update(task, completed=done),
+            problem_class=problem_class,
         )
     summary["results"] = str(out_dir / "results.parquet")
     if missing and methods is None:
@@ -120,16 +116,18 @@ def _print(summary: dict[str, Any]) -> None:
     from rich.table import Table
 
     table = Table(
-        title=f"{summary['problems']} problems, seed {summary['seed']}: success = no "
-        "collision, limits kept, RMS < 1 mm after 1 s"
+        title=f"{summary['problems']} {summary['class']} problems, seed {summary['seed']}: "
+        "success = no collision, limits kept, RMS < 1 mm after 1 s"
     )
-    for name in ("method", "success", "median µs", "p99 µs", "RMS mm", "min clear. mm", "failures"):
+    names = ("method", "success", "mean µs", "median µs", "p99 µs", "RMS mm", "min clear. mm")
+    for name in (*names, "failures"):
         table.add_column(name, justify="left" if name in ("method", "failures") else "right")
     for method, m in summary["methods"].items():
         failures = ", ".join(f"{k} {v}" for k, v in m["failures"].items() if v) or "—"
         table.add_row(
             method,
             f"{100 * m['success_rate']:.0f} %",
+            _number(m["mean_step_us"], 0),
             _number(m["median_step_us"], 0),
             _number(m["p99_step_us"], 0),
             _number(m["median_rms_error_m"], 3, 1e3),

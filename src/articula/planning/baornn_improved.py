@@ -12,6 +12,11 @@
    move the arm far enough to leave a poor posture; the short ones refine within a fraction of
    the error, which the long ones overshoot (with them alone the RMS error on the book's
    two-obstacle circle stays near 0.6 mm; with both, 0.25 mm: docs/deviations.md).
+5. Tracking first: while the arm is at least `yield_distance` clear, no point with a larger
+   task error than the period's start is accepted, so the penalty moves the arm through the
+   redundancy only. The book's g trades error for clearance one to one (Λ/d² > 1 within
+   √Λ = 71 mm for Λ = 0.005): with speed limits that trade drifted the arm into a posture
+   whose joint limits leave no redundancy, ~20 mm off the path (docs/deviations.md).
 """
 
 from __future__ import annotations
@@ -37,10 +42,13 @@ class ImprovedParams(BaornnParams):
         iterations_per_step: iterations per control period.
         pairs: antenna pairs per iteration (at most the number of joints are used).
         short_antenna: length of every second pair relative to λ_k, in (0, 1].
+        yield_distance: clearance below which a step may raise the task error; above it a
+            period never does (change 5); inf: never capped, the book's acceptance [m].
     """
 
     pairs: Annotated[int, Field(ge=1, le=64)] = 3
     short_antenna: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.25
+    yield_distance: Annotated[float, Field(ge=0)] = 0.03
 
 
 @dataclass
@@ -78,11 +86,18 @@ class ImprovedBaornn(BeetleSearch):
         draw = self.rng.standard_normal((q.size, min(p.pairs, q.size)))
         return self._search(q, g, np.zeros(0), as_target(target), draw[None], t)
 
+    def _cap(self, q: np.ndarray, g: float, target: Target, t: float) -> float:
+        """The cap on an accepted point's task error for a period from (q, g) [m]
+        (baornn_kernel.tracking_cap)."""
+        obj = self.objective
+        d = obj.evaluation.measure(q, t, obj.needs_obstacles, False)[0]
+        return kernel.tracking_cap(obj.tracking_error(q, target), g, d, self.params.yield_distance)
+
     def _iteration(
-        self, q: np.ndarray, g: float, target: Target, draw: np.ndarray, t: float
+        self, q: np.ndarray, g: float, target: Target, draw: np.ndarray, t: float, cap: float
     ) -> tuple[np.ndarray, float]:
-        """One iteration in Python from (q, g) with the Gaussian matrix `draw` (the compiled
-        kernel's reference); returns the accepted (q, g)."""
+        """One iteration in Python from (q, g) with the Gaussian matrix `draw`, accepting no
+        task error above `cap` (the compiled kernel's reference); returns the accepted (q, g)."""
         obj, p = self.objective, self.params
         model = obj.scene.robot.model
         box = self._box or (model.lowerPositionLimit, model.upperPositionLimit)
@@ -106,7 +121,7 @@ class ImprovedBaornn(BeetleSearch):
                 # A difference over a shorter antenna counts as much per unit length.
                 gradient += (g_left - g_right) / scale * b
             for q_a, g_a in ((q_left, g_left), (q_right, g_right)):
-                if g_a < best_g:
+                if g_a < best_g and obj.tracking_error(q_a, target) <= cap:
                     best_q, best_g = q_a, g_a
         norm = math.sqrt(gradient @ gradient)
         self.evaluations += 2 * directions.shape[0]
@@ -114,7 +129,8 @@ class ImprovedBaornn(BeetleSearch):
             step = q - p.c2 * lam * gradient / norm  # Eq. (1.19) along the estimated gradient
             q_new, g_new = obj.project_and_value(step, q, g, target, t, self._box, self._stop)
             self.evaluations += 1
-            if g_new < best_g:  # Eqs. (1.21)-(1.22): only an improvement is accepted
+            # Eqs. (1.21)-(1.22): only an improvement is accepted
+            if g_new < best_g and obj.tracking_error(q_new, target) <= cap:
                 best_q, best_g = q_new, g_new
         self.iterations += 1
         return best_q, best_g
@@ -184,6 +200,7 @@ class ImprovedBaornn(BeetleSearch):
                 p.c1,
                 p.c2,
                 p.short_antenna,
+                p.yield_distance,
                 obj.problem(self._box, t, self._stop),
             )
             self.evaluations += evaluations
@@ -191,11 +208,12 @@ class ImprovedBaornn(BeetleSearch):
             return q, g
         if math.isnan(g):  # g at q, inf outside Ω: any point inside it is better
             g = obj.project_and_value(q, q, math.inf, target, t, (q, q), self._stop)[1]
+        cap = self._cap(q, g, target, t)
         if warm.size:
             q_warm, g_warm = obj.project_and_value(q + warm, q, g, target, t, self._box, self._stop)
             self.evaluations += 1
-            if g_warm < g:
+            if g_warm < g and obj.tracking_error(q_warm, target) <= cap:
                 q, g = q_warm, g_warm
         for draw in draws:
-            q, g = self._iteration(q, g, target, draw, t)
+            q, g = self._iteration(q, g, target, draw, t, cap)
         return q, g

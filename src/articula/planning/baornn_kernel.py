@@ -246,6 +246,25 @@ def antenna_scale(pair: int, short: float) -> float:
 
 
 @jit()
+def tracking_cap(e: float, g: float, d: float, yield_distance: float) -> float:
+    """The largest task error [m] a baornn-improved period may accept: e, the error at its
+    start, while the arm is at least yield_distance clear (the penalty then moves the arm
+    only through the redundancy, never off the path); inf closer, or from a start outside Ω
+    (g = inf), where g alone decides as in Eq. (1.21).
+
+    Args:
+        e: the task error at the period's start [m].
+        g: the objective there (inf outside Ω).
+        d: the start's smallest link-obstacle clearance [m].
+        yield_distance: the clearance below which the task error may grow [m].
+
+    Returns:
+        The cap on an accepted point's task error [m].
+    """
+    return e if math.isfinite(g) and d >= yield_distance else math.inf
+
+
+@jit()
 def _orthonormal_columns(draw):
     """The columns of `draw` (n × m, m ≤ n) made orthonormal by Gram-Schmidt, as rows: the Q
     of its QR up to the signs of its columns (which only swap an antenna pair's ends)."""
@@ -258,11 +277,14 @@ def _orthonormal_columns(draw):
 
 
 @jit()
-def improved_period(q, g_known, warm_motion, reference, draws, c1, c2, short, problem):
+def improved_period(q, g_known, warm_motion, reference, draws, c1, c2, short, yield_distance,
+                    problem):  # fmt: skip
     """One control period of baornn-improved (planning/baornn_improved.py): g at q for the
     new reference (inf outside Ω; g_known instead when it is not NaN: a caller's g(q)), the
     warm start q + warm_motion (none when it is empty), then one iteration per draws[k], an
     (n × pairs) Gaussian matrix whose orthonormalised columns are the antenna directions.
+    While q is at least yield_distance clear, no accepted point has a larger task error than
+    q has (tracking_cap).
 
     Args:
         q: joint angles at the start of the period, shape (nq,) [rad].
@@ -273,6 +295,7 @@ def improved_period(q, g_known, warm_motion, reference, draws, c1, c2, short, pr
         c1: antenna length constant, λ_k = c1·√e_k [rad/√m].
         c2: step constant of Eq. (1.24).
         short: relative length of every second antenna pair.
+        yield_distance: the clearance below which the task error may grow [m].
         problem: g's weights and Ω (Problem, packed: Objective.problem).
 
     Returns:
@@ -288,16 +311,17 @@ def improved_period(q, g_known, warm_motion, reference, draws, c1, c2, short, pr
         or not _braking_clear(q, d, d_self, problem)
     ):
         g = math.inf  # a start outside Ω: any point inside it is better
+    cap = tracking_cap(e, g, d, yield_distance)
     evaluations = 0
     if warm_motion.size:
         q_warm, g_warm, e_warm = _project_and_value(q + warm_motion, q, g, e, reference, problem)
         evaluations += 1
-        if g_warm < g:
+        if g_warm < g and e_warm <= cap:
             q, g, e = q_warm, g_warm, e_warm
     n = q.size
-    cap = antenna_cap(problem.lower, problem.upper)
+    longest = antenna_cap(problem.lower, problem.upper)
     for k in range(draws.shape[0]):
-        lam = min(c1 * math.sqrt(e), cap)  # c1·√e_k, e_k the task error at the accepted q
+        lam = min(c1 * math.sqrt(e), longest)  # c1·√e_k, e_k the task error at the accepted q
         directions = _orthonormal_columns(draws[k])
         gradient = np.zeros(n)
         best_q, best_g, best_e = q, g, e
@@ -313,16 +337,16 @@ def improved_period(q, g_known, warm_motion, reference, draws, c1, c2, short, pr
             evaluations += 2
             if math.isfinite(g_left) and math.isfinite(g_right):
                 gradient += (g_left - g_right) / scale * b
-            if g_left < best_g:
+            if g_left < best_g and e_left <= cap:
                 best_q, best_g, best_e = q_left, g_left, e_left
-            if g_right < best_g:
+            if g_right < best_g and e_right <= cap:
                 best_q, best_g, best_e = q_right, g_right, e_right
         norm = math.sqrt(gradient @ gradient)
         if norm > 0.0:
             step = q - c2 * lam * gradient / norm  # Eq. (1.19) along the estimated gradient
             q_new, g_new, e_new = _project_and_value(step, q, g, e, reference, problem)
             evaluations += 1
-            if g_new < best_g:  # Eqs. (1.21)-(1.22)
+            if g_new < best_g and e_new <= cap:  # Eqs. (1.21)-(1.22)
                 best_q, best_g, best_e = q_new, g_new, e_new
         q, g, e = best_q, best_g, best_e
     return q, g, evaluations

@@ -131,6 +131,9 @@ class PlannerSpec(StrictModel):
         c2: step constant of Eq. (1.24), BAORNN.
         pairs: antenna pairs per iteration, baornn-improved.
         short_antenna: relative length of every second antenna pair, baornn-improved.
+        yield_distance: clearance below which baornn-improved may leave the path to keep
+            clear; above it the penalty moves the arm through the redundancy only; inf: the
+            book's acceptance [m].
         gain: K on the task error, baselines [1/s].
         damping: μ of damped least squares, dls [m].
         repulsion: η of the obstacle repulsion, pinv and dls [m²/s].
@@ -173,6 +176,7 @@ class PlannerSpec(StrictModel):
     c2: Positive = 0.5
     pairs: Annotated[int, Field(ge=1, le=64)] = 3
     short_antenna: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.25
+    yield_distance: Annotated[float, Field(ge=0)] = 0.03
     gain: NonNegative = 20.0
     damping: NonNegative = 0.02
     repulsion: NonNegative = 0.02
@@ -243,13 +247,8 @@ def _planner(spec: PlannerSpec, scene: Scene, seed: int) -> Planner:
         params = BaornnParams(c1=spec.c1, c2=spec.c2, iterations_per_step=spec.iterations_per_step)
         return Baornn(objective, params, rng, rate)
     if spec.method == "baornn-improved":
-        improved = ImprovedParams(
-            c1=spec.c1,
-            c2=spec.c2,
-            pairs=spec.pairs,
-            short_antenna=spec.short_antenna,
-            iterations_per_step=spec.iterations_per_step,
-        )
+        # Every ImprovedParams field has a [planner] key of its name.
+        improved = ImprovedParams(**{k: getattr(spec, k) for k in ImprovedParams.model_fields})
         return ImprovedBaornn(objective, improved, rng, rate)
     if spec.method == "qp":
         qp = QpIkParams(

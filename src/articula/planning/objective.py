@@ -108,7 +108,7 @@ class Objective:
         pairs, static_min = c.select(self.needs_obstacles, True)
         if box is not None:
             # A period's reach, and where braking from it ends: far obstacles drop out.
-            pairs = c.near_pairs(pairs, _braking_box(box, stop))
+            pairs = c.near_pairs(pairs, _braking_box(box, stop), self.sweep)
         lower, upper = box or (robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
         # Packed by hand: the clearance comes packed, and the rest are arrays and numbers.
         return tuple(Problem(self.lambda_weight, self.beta, self.d_min, self.self_d_min, lower,

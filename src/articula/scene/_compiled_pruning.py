@@ -32,12 +32,12 @@ def _pair_bounds(q, chain, shapes, pairs):
 
 
 @jit()
-def _near_pairs(lower, upper, reach, static_min, packed_inputs):
+def _near_pairs(lower, upper, sweep, static_min, packed_inputs):
     """CompiledClearance.near_pairs in one compiled call (it runs once per control period)."""
     inputs = named_inputs(packed_inputs)
     chain, shapes, pairs = inputs.chain, inputs.shapes, inputs.pairs
     centre = (lower + upper) / 2.0
-    delta = reach * np.sum(upper - lower) / 2.0
+    delta = np.sum(sweep * (upper - lower)) / 2.0
     below, above = _pair_bounds(centre, chain, shapes, pairs)
     ceiling = static_min
     for k in range(pairs.shape[0]):

@@ -217,23 +217,33 @@ class CompiledClearance:
                                      np.where(keep, self.static_min, np.inf))  # fmt: skip
         return self._selected[kinds]
 
-    def near_pairs(self, pairs: np.ndarray, box: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+    def near_pairs(
+        self,
+        pairs: np.ndarray,
+        box: tuple[np.ndarray, np.ndarray],
+        sweep: np.ndarray | None = None,
+    ) -> np.ndarray:
         """The rows of `pairs` that can hold the smallest link-obstacle distance anywhere in
         `box` (lower, upper joint angles [rad]); link pairs are all kept.
 
-        A shape point moves at most reach · Σ|Δq_j| from the box's centre c, so over the box
-        a pair stays above its lower bound at c less that δ, and the smallest distance stays
-        below the smallest upper bound at c plus δ: a pair whose lower bound exceeds that by
-        2δ can never be the minimum (nor reach GJK in `_evaluate`'s broad phase).
+        A shape point moves at most δ = Σ_j sweep_j |Δq_j| from the box's centre c (sweep_j
+        = reach without a per-joint bound), so over the box a pair stays above its lower
+        bound at c less δ, and the smallest distance stays below the smallest upper bound at
+        c plus δ: a pair whose lower bound exceeds that by 2δ can never be the minimum (nor
+        reach GJK in `_evaluate`'s broad phase).
 
         Args:
             pairs: pair rows, as in `pairs`, shape (k, 5).
             box: (lower, upper) joint angles, each shape (nq,) [rad].
+            sweep: per joint, how far a shape point moves at most per unit of its motion,
+                shape (nq,) [m/rad] (robots.sweep.joint_sweep); None: `reach` for each.
 
         Returns:
             The rows kept, shape (k', 5).
         """
-        return _near_pairs(box[0], box[1], self.reach, self.static_min[OBSTACLE],
+        lower, upper = box
+        weights = np.full(lower.size, self.reach) if sweep is None else sweep
+        return _near_pairs(lower, upper, weights, self.static_min[OBSTACLE],
                            self.inputs(pairs))  # fmt: skip
 
     def inputs(self, pairs: np.ndarray | None = None) -> tuple:
