@@ -15,6 +15,7 @@ period, and draws the end-effector path against the target and the clearance ove
 """
 
 import argparse
+import os
 from importlib import resources
 from pathlib import Path
 
@@ -77,7 +78,9 @@ def main():
     for ax in (path, error, clearance):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
-    fig.savefig(args.out / "circle.png", dpi=120)
+    path = args.out / "circle.png"
+    fig.savefig(path, dpi=120)
+    print(f"figure: {os.path.relpath(path)}")
 
 
 if __name__ == "__main__":

@@ -14,6 +14,7 @@ and whether the hard minimum distance held.
 """
 
 import argparse
+import os
 from importlib import resources
 from pathlib import Path
 
@@ -109,7 +110,9 @@ def main():
     bars.set(ylabel="min distance to an obstacle [mm]", title="each link, over the run")
     clearance.set(xlabel="t [s]", ylabel="min link-obstacle distance [mm]", title="clearance")
     clearance.set_ylim(bottom=0)
-    fig.savefig(args.out / "clearance.png", dpi=120)
+    path = args.out / "clearance.png"
+    fig.savefig(path, dpi=120)
+    print(f"figure: {os.path.relpath(path)}")
 
 
 if __name__ == "__main__":

@@ -15,6 +15,7 @@ and the ball's position over time.
 """
 
 import argparse
+import os
 import time
 from pathlib import Path
 
@@ -111,7 +112,9 @@ def main():
         ax.grid(alpha=0.3)
     clearance.legend(fontsize=8)
     compute.legend(fontsize=8)
-    fig.savefig(args.out / "online_loop.png", dpi=120)
+    path = args.out / "online_loop.png"
+    fig.savefig(path, dpi=120)
+    print(f"figure: {os.path.relpath(path)}")
 
 
 if __name__ == "__main__":

@@ -6,6 +6,8 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import pytest
+
 from tests.test_docstrings import public_modules
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -26,3 +28,35 @@ def test_every_example_has_a_page_in_the_navigation():
         assert page.is_file(), f"{script.name} has no page {page.relative_to(ROOT)}"
         assert f"examples/{script.stem}.md" in nav, f"{page.name} is not in mkdocs.yml's nav"
         assert f'--8<-- "examples/{script.name}"' in page.read_text(encoding="utf-8")
+
+
+def test_the_getting_started_snippet_prints_what_the_page_says(capsys):
+    page = (DOCS / "getting-started.md").read_text(encoding="utf-8")
+    section = page[page.index("## From Python") :]
+    code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    shown = re.search(r"It prints.*?```text\n(.*?)```", section, re.S).group(1)
+    exec(compile(code, "getting-started.md", "exec"), {})
+    assert capsys.readouterr().out == shown
+
+
+def test_the_api_reference_lists_a_pydantic_models_fields():
+    # mkdocs.yml loads griffe_pydantic; the same extension must see the fields.
+    griffe = pytest.importorskip("griffe", reason='the docs extra: pip install -e ".[docs]"')
+    assert "griffe_pydantic" in (ROOT / "mkdocs.yml").read_text(encoding="utf-8")
+    extensions = griffe.load_extensions("griffe_pydantic")
+    module = griffe.load("articula.planning.baornn_improved", search_paths=[ROOT / "src"],
+                         extensions=extensions)  # fmt: skip
+    params = module["ImprovedParams"]
+    assert "pydantic-model" in params.labels
+    fields = {name for name, member in params.members.items() if "pydantic-field" in member.labels}
+    assert {"pairs", "short_antenna", "yield_distance"} <= fields
+
+
+def test_the_your_arm_page_runs_and_prints_what_it_says(capsys, tmp_path, monkeypatch):
+    page = (DOCS / "guides" / "your-arm.md").read_text(encoding="utf-8")
+    code = re.search(r"```python\n(.*?)```", page, re.S).group(1)
+    shown = re.search(r"It prints.*?```text\n(.*?)```", page, re.S).group(1)
+    monkeypatch.chdir(tmp_path)  # it writes its mesh, rock.stl, where it runs
+    exec(compile(code, "your-arm.md", "exec"), {})
+    assert capsys.readouterr().out == shown
+    assert (tmp_path / "rock.stl").is_file()

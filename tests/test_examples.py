@@ -51,3 +51,5 @@ def test_example_runs_at_reduced_size(script, tmp_path):
     figures = list(tmp_path.rglob("*.png"))
     assert figures, "an example draws what it found"
     assert all(p.stat().st_size > 0 for p in figures)
+    for figure in figures:  # and says where each one went
+        assert figure.name in proc.stdout, figure
