@@ -21,6 +21,7 @@ from articula.validation import load_toml
 
 CHROMIUM_INSTALL = "apt-get install -y chromium"
 CONFIGS = Path(__file__).resolve().parents[2] / "src/articula/book/ch1/configs"
+SOFTWARE_GL_NOTICE = "#webgl-software-rendering"  # viser's "Software WebGL rendering detected"
 ORANGE = np.array([255, 140, 0])  # viewer.drawing.ROBOT_COLOUR, shaded by the lights
 
 
@@ -115,6 +116,7 @@ def open_page(browser, url: str, wait_for: str = "closest:"):
     page.goto(url)
     page.get_by_text("Connected").wait_for(timeout=60_000)
     page.get_by_text(wait_for).first.wait_for(timeout=60_000)
+    page.add_style_tag(content=f"{SOFTWARE_GL_NOTICE} {{display: none}}")  # not in screenshots
     wait_for_frames(page, 30)  # software WebGL draws a few frames
     return page
 

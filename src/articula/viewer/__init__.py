@@ -10,4 +10,5 @@ __all__ = [
     "painter",
     "replay",
     "run_data",
+    "time_plot",
 ]

@@ -3,11 +3,13 @@
 Every control period reads each obstacle's drag gizmo, steps the same OnlineController that
 `articula plan` uses (its obstacles live), and hands the arm's picture to a painter thread
 that moves it on the page (viewer/painter.py: the loop never waits on the browser). The
-end-effector target follows the scene's trajectory or a gizmo of its own; the method, Λ and
-d_min can be changed from the panel (the controller is rebuilt from the arm's current
-configuration). With a plant (`--plant mujoco`, viewer/live_plant.py) the commands drive the
-MuJoCo twin, the controller closes its loop on the joints it measures, and the measured arm is
-drawn beside the commanded one.
+end-effector target follows the scene's trajectory (drawn in blue) or a goal marker of its own:
+dragging the marker switches the following off, and the readout then gives the tool's error
+from the goal. The method, Λ and d_min can be changed from the panel (the controller is
+rebuilt from the arm's current configuration); the gizmos are sized to the arm. With a plant
+(`--plant mujoco`, viewer/live_plant.py) the commands drive the MuJoCo twin, the controller
+closes its loop on the joints it measures, and the measured arm is drawn beside the commanded
+one; a checkbox each shows or hides them.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from articula.planning.config import (
     METHODS,
     PlannerSpec,
 )
+from articula.robots.sweep import joint_sweep
 from articula.signals import Terminated, terminate_as_interrupt
 from articula.viewer import drawing
 from articula.viewer.live_plant import COMMANDED_OPACITY, LivePlant
@@ -36,9 +39,12 @@ from articula.viewer.run_data import visuals_of
 READOUT_EVERY = 9  # periods between readouts (~10 a second, what a person reads); a
 # multiple of DRAW_EVERY, as a readout goes out with a picture
 DRAW_EVERY = 3  # periods between pictures: 33 Hz at 10 ms, smooth to the eye (each is
-
-
 # pushed to the page by the painter's thread, viewer/painter.py: the loop never waits on it)
+OBSTACLE_GIZMO = 0.6  # an obstacle's drag gizmo, as a fraction of the arm's reach
+GOAL_GIZMO = 0.5  # the goal marker's, likewise
+REFERENCE_POINTS = 2000  # vertices of the drawn reference path
+
+
 class Live:
     """The live page of one scene file in one viser server.
 
@@ -61,6 +67,7 @@ class Live:
             "d_min [m]", float(planner.get("d_min", 0.0)), min=0.0, step=1e-3
         )
         self.follow = gui.add_checkbox("follow the trajectory", True)
+        self.show_commanded = gui.add_checkbox("commanded arm", True)
         self.readout = gui.add_markdown("")
         self.refusal: str | None = None  # the last refused setting, shown until a change
         self._reverting = False  # the panel is being put back: not a change of the user's
@@ -71,16 +78,22 @@ class Live:
         visuals = visuals_of(self.config["robot"], self.scene)
         ghost = None if loaded.validated.plant is None else COMMANDED_OPACITY
         self.frames, self.meshes = drawing.add_robot(server, visuals, opacity=ghost)
+        self.show_commanded.on_update(lambda _: self._show_arm(self.frames, self.show_commanded))
+        reach = float(joint_sweep(self.scene.robot)[0])  # [m] the arm's size sets the gizmos'
         self.gizmos = {}
         for obstacle in self.scene.obstacles:
             wxyz, position = drawing.wxyz_position(obstacle.pose_at(0.0))
             self.gizmos[obstacle.name] = server.scene.add_transform_controls(
-                f"/obstacles/{obstacle.name}", scale=0.2, wxyz=wxyz, position=position
+                f"/obstacles/{obstacle.name}", OBSTACLE_GIZMO * reach, wxyz=wxyz, position=position
             )
         drawing.add_obstacle_parts(server, self.scene)
+        horizon = self.targets.duration + float(planner.get("duration", 50.0))
+        path = [self.targets(t).position for t in np.linspace(0.0, horizon, REFERENCE_POINTS)]
+        drawing.add_path(server, "/reference", np.array(path), drawing.REFERENCE_COLOUR)
         self.target = server.scene.add_transform_controls(
-            "/target", scale=0.15, disable_rotations=True
+            "/target", GOAL_GIZMO * reach, disable_rotations=True
         )
+        self.target.on_update(self._goal_moved)
         server.scene.add_icosphere("/target/ball", radius=0.01, color=drawing.REFERENCE_COLOUR)
         self.recording = Recording()
         self.colours: dict[str, tuple[int, int, int]] = {}  # as painted (painter's thread)
@@ -91,6 +104,10 @@ class Live:
         self.plant = None
         if loaded.validated.plant is not None:
             self.plant = LivePlant(server, loaded.validated, self.scene, self.q0, visuals)
+            self.show_measured = gui.add_checkbox("measured arm", True)
+            self.show_measured.on_update(
+                lambda _: self._show_arm(self.plant.frames, self.show_measured)
+            )
         self.rebuild()
 
     @property
@@ -140,6 +157,18 @@ class Live:
             "lambda_weight": spec.lambda_weight,
             "d_min": spec.d_min,
         }
+
+    def _goal_moved(self, event: viser.TransformControlsEvent) -> None:
+        """A drag of the goal marker begins: the following switches off (the goal stays where
+        the marker is let go, until the box is ticked again)."""
+        if event.phase == "start":
+            self.follow.value = False
+
+    @staticmethod
+    def _show_arm(frames: dict[str, viser.FrameHandle], box: viser.GuiCheckboxHandle) -> None:
+        """Show or hide an arm's link frames (and so its meshes) as its checkbox says."""
+        for frame in frames.values():
+            frame.visible = box.value
 
     def _revert_panel(self) -> None:
         """Put the panel's method, Λ and d_min back to the controller's in force."""
@@ -227,7 +256,8 @@ class Live:
     def _readout(self, x: np.ndarray, target: np.ndarray, clearance: float, elapsed: float) -> str:
         """The panel's line: clearance, error, the planner's time (and the measured arm's)."""
         error = float(np.linalg.norm(x - target))
-        readout = f"clearance **{1e3 * clearance:.1f} mm** · error {1e3 * error:.2f} mm"
+        name = "error" if self.follow.value else "goal error"  # the marker's goal, not the path
+        readout = f"clearance **{1e3 * clearance:.1f} mm** · {name} {1e3 * error:.2f} mm"
         if self.plant is not None:
             tool = self.scene.robot.ee_position(self.plant.q)
             readout += (

@@ -4,7 +4,9 @@ The page shows the links (their URDF visual meshes, else collision hulls) colour
 clearance, the obstacles, the reference path (blue) and the achieved end-effector path
 (green), and at the current time the closest link-obstacle pair as a red segment between its
 witness points with its distance. The panel has a run picker (a sweep folder), a time slider,
-play/pause and speed, and plots of error and clearance against time.
+play/pause and speed, a trail (the arm at TRAIL_POSES times over the run, as MoveIt's
+trajectory trail), and plots of error and clearance against time with a cursor at the
+scene's time (viewer/time_plot.py).
 """
 
 from __future__ import annotations
@@ -16,17 +18,19 @@ from pathlib import Path
 
 import numpy as np
 import viser
-import viser.uplot as uplot
 
 from articula.errors import ConfigError
 from articula.native import captured_output
 from articula.signals import terminate_as_interrupt
 from articula.viewer import drawing
 from articula.viewer.run_data import RunData, load_run, run_folders
+from articula.viewer.time_plot import TimePlot
 
 SPEEDS = ("0.25", "0.5", "1", "2", "4")
 FRAME_S = 1.0 / 30.0  # [s] between frames while playing
 ERROR_FLOOR_MM = 1e-3  # [mm] the error plot's floor on its log axis (1 µm)
+TRAIL_POSES = 8  # arms drawn along the run by the trail
+TRAIL_OPACITY = 0.25
 
 
 class Replay:
@@ -48,12 +52,15 @@ class Replay:
         self.slider = gui.add_slider("time [s]", 0.0, 1.0, 0.01, 0.0)
         self.playing = gui.add_checkbox("play", False)
         self.speed = gui.add_dropdown("speed", SPEEDS, initial_value="1")
+        self.trail = gui.add_checkbox("trail", False)
         self.status = gui.add_markdown("")
-        self.plots: list = []
+        self.plots: list[TimePlot] = []
+        self.ghosts: list[viser.FrameHandle] = []
         self.run: RunData | None = None
         self.index = 0
         self.picker.on_update(lambda _: self.load(self.runs[self.picker.value]))
         self.slider.on_update(lambda _: self.show(self._index_at(self.slider.value)))
+        self.trail.on_update(lambda _: self._draw_trail())
         drawing.aim_camera(server)
         self.load(runs[0])
 
@@ -78,18 +85,17 @@ class Replay:
         self.slider.step = float(run.t[1] - run.t[0]) if len(run.t) > 1 else 0.01
         for plot in self.plots:
             plot.remove()
+        gui = self.server.gui
+        error = np.maximum(1e3 * run.error, ERROR_FLOOR_MM)
+        clearance = 1e3 * np.where(np.isfinite(run.clearance), run.clearance, np.nan)
         self.plots = [
             # Log axis: the approach's 100 mm and the path's tenths of a millimetre both show
             # (floored at 1 µm, where a log axis would lose an exact zero).
-            self._plot(
-                "error [mm], log", run.t, np.maximum(1e3 * run.error, ERROR_FLOOR_MM), log=True
-            ),
-            self._plot(
-                "clearance [mm]",
-                run.t,
-                1e3 * np.where(np.isfinite(run.clearance), run.clearance, np.nan),
-            ),
+            TimePlot(gui, "error [mm], log", run.t, error, log=True),
+            TimePlot(gui, "clearance [mm]", run.t, clearance),
         ]
+        self.ghosts = []  # the scene's reset took them
+        self._draw_trail()
         self.show(0)
 
     def show(self, k: int) -> None:
@@ -126,6 +132,25 @@ class Replay:
                 f" · closest: {closest.link} – {closest.obstacle}, {1e3 * closest.distance:.1f} mm"
             )
         self.status.content = text
+        for plot in self.plots:
+            plot.at(float(run.t[k]))
+
+    def _draw_trail(self) -> None:
+        """Draw the arm see-through at TRAIL_POSES evenly spaced samples (trail ticked), or take
+        those arms away."""
+        for frame in self.ghosts:
+            frame.remove()
+        self.ghosts = []
+        run = self.run
+        if run is None or not self.trail.value:
+            return
+        for i, k in enumerate(np.linspace(0, len(run.t) - 1, TRAIL_POSES).astype(int)):
+            frames, _ = drawing.add_robot(
+                self.server, run.visuals, f"/trail/{i}", opacity=TRAIL_OPACITY
+            )
+            for name, T in run.link_poses(int(k)).items():
+                frames[name].wxyz, frames[name].position = drawing.wxyz_position(T)
+            self.ghosts += frames.values()
 
     def tick(self, elapsed: float) -> None:
         """Advance by `elapsed` of wall time times the speed while playing.
@@ -146,20 +171,6 @@ class Replay:
         """The sample at time t [s] (the last one at or before it)."""
         assert self.run is not None
         return int(np.clip(np.searchsorted(self.run.t, t + 1e-9) - 1, 0, len(self.run.t) - 1))
-
-    def _plot(self, label: str, t: np.ndarray, values: np.ndarray, log: bool = False):
-        """A small uPlot of one series against time (its value axis logarithmic with `log`)."""
-        value_scale = uplot.Scale(distr=3, log=10) if log else uplot.Scale()
-        return self.server.gui.add_uplot(
-            data=(t, values),
-            series=(
-                uplot.Series(label="t [s]"),
-                uplot.Series(label=label, stroke="#d9480f", scale="value"),
-            ),
-            scales={"x": uplot.Scale(time=False), "value": value_scale},
-            title=label,
-            aspect=2.0,
-        )
 
 
 def open_server(host: str, port: int) -> viser.ViserServer:
