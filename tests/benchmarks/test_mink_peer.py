@@ -152,10 +152,31 @@ def test_peers_benchmark_prints_its_keys_as_one_json_object():
     keys = ["qp_step_us", "improved_step_us", "mink_step_us", "qp_vs_mink", "improved_vs_mink",
             "qp_per_far_obstacle_us", "improved_per_far_obstacle_us", "mink_per_far_obstacle_us",
             "qp_rms_m", "improved_rms_m", "mink_rms_m", "qp_min_clearance_m",
-            "improved_min_clearance_m", "mink_min_clearance_m"]  # fmt: skip
+            "improved_min_clearance_m", "mink_min_clearance_m", "qp_per_near_obstacle_us",
+            "improved_per_near_obstacle_us", "mink_per_near_obstacle_us"]  # fmt: skip
     for key in keys:
         assert np.isfinite(m[key]), key
     for name in ("qp", "improved", "mink"):
         assert m[f"{name}_step_us"] > 0
     assert m["qp_vs_mink"] == pytest.approx(m["qp_step_us"] / m["mink_step_us"])
     assert m["far_min_distance_m"] > m["detection_m"]
+    # The near obstacles: within reach, outside the detection distance of every motion.
+    assert m["detection_m"] < m["near_distance_m"][0] <= m["near_distance_m"][1] <= 0.6
+
+
+def test_clutter_benchmark_prints_its_keys_as_one_json_object():
+    proc = subprocess.run(
+        [sys.executable, str(BENCHMARKS / "clutter.py"), "--json", "--steps", "40"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stderr
+    m = json.loads(proc.stdout)
+    assert m["obstacles"] == 50 and m["clutter_distance_m"] >= 0.2
+    for name in ("qp", "improved", "mink"):
+        assert m[f"{name}_clutter_ratio"] == pytest.approx(
+            m[f"{name}_step_us_50"] / m[f"{name}_step_us_2"]
+        )
+        assert m[f"{name}_min_clearance_m_50"] > -0.01  # mink's default gain dips 2 mm in
