@@ -86,7 +86,7 @@ def test_dragging_the_goal_marker_stops_the_following_and_the_tool_goes_there(li
     periods = live.periods
 
     def reached() -> bool:
-        return np.linalg.norm(live.scene.robot.ee_position(live.q) - goal) < 1e-3
+        return np.linalg.norm(live.scene.robot.ee_position(live.q) - goal) < 1e-4
 
     wait_until(reached, "the tool to reach the goal")
     wait_until(lambda: live.periods > periods + READOUT_EVERY, "a readout after it")
