@@ -102,3 +102,15 @@ def test_bad_options_are_one_line_and_exit_2(tmp_path, cli, options, named):
     proc = cli("bench", "suite", "--out", tmp_path / "s", *options)
     assert proc.returncode == 2
     assert len(proc.stderr.strip().splitlines()) == 1 and named in proc.stderr
+
+
+def test_the_tight_suite_on_dask_gives_the_local_numbers(tmp_path):
+    # Same problems, seed and methods: the rows do not depend on the backend.
+    runs = {}
+    for backend in (None, "local"):
+        out = tmp_path / f"suite-{backend}"
+        suite.run_suite({"builtin": "iiwa14"}, 2, 5, out, ["qp"], workers=1, dask=backend,
+                        problem_class="tight")  # fmt: skip
+        rows = pq.read_table(out / "results.parquet").to_pylist()
+        runs[backend] = [{k: v for k, v in r.items() if not k.endswith("_us")} for r in rows]
+    assert runs[None] == runs["local"] and len(runs[None]) == 2
