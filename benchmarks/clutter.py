@@ -29,54 +29,31 @@ from typing import Any
 
 import numpy as np
 from common import run
-from peers import INFLUENCE, INSTALL, SCENE, Lane, _articula, _mink, _race
+from peers import INSTALL, SHOULDER, BookRace, _race, check_steps, with_obstacles
 
-from articula.book.study import packaged
-from articula.experiments.plan import build_plan
 from articula.geometry.poses import pose
 from articula.geometry.shapes import box, convex_hull
-from articula.planning.config import PlannerSpec
 from articula.scene.obstacles import Obstacle
 from articula.scene.scene import Scene
-from articula.validation import load_toml
 
 ADDED = 48  # obstacles added to the book's two: 50 in the cell
 CELL_RADIUS = 1.3  # [m] from the base axis
 CLEAR = 0.2  # [m] from every link over the pilot motions
-SHOULDER = np.array([0.0, 0.0, 0.36])  # [m] the iiwa14's second joint
 NAMES = ("qp", "improved", "mink")
 
 
 def measure(steps: int) -> dict[str, Any]:
     """Run the pilot and the race and return the measures (see the module's docstring)."""
-    from articula.bench.mink_peer import MinkArm  # pip install -e '.[peers]'
-
-    if steps < 2:
-        print("error: --steps must be at least 2", file=sys.stderr)
-        raise SystemExit(2)
-    path = packaged("ch1", SCENE)
-    data = load_toml(path)
-    table = {**data["planner"], "limits": "velocity", "influence": INFLUENCE}
-    plan = build_plan({**data, "planner": table}, path.parent, str(path))
-    scene, q0, targets, seed = plan.scene, plan.q0, plan.targets, plan.config.seed
-    specs = {
-        "qp": PlannerSpec(**{**table, "method": "qp"}),
-        "improved": PlannerSpec(**{**table, "method": "baornn-improved"}),
-    }
-    d_min, dt = specs["qp"].d_min, specs["qp"].dt
-    reference = np.array([targets(n * dt).position for n in range(steps)])
-
-    def lanes(s: Scene, suffix: str) -> list[Lane]:
-        out = [Lane(f"{n}{suffix}", _articula(s, specs[n], seed, q0)) for n in NAMES[:2]]
-        out.append(Lane(f"mink{suffix}", _mink(MinkArm(s, d_min, INFLUENCE, dt), q0)))
-        return out
-
-    pilot = lanes(scene, "")
+    check_steps(steps)
+    race = BookRace.load()
+    scene, dt = race.scene, race.dt
+    reference = race.reference(steps)
+    pilot = race.lanes(scene)
     _race(pilot, reference)
     motion = [q for lane in pilot for q in lane.qs[::10]]
     cluttered, distance = with_clutter(scene, motion)
-    race = lanes(scene, "_2") + lanes(cluttered, "_50")
-    _race(race, reference)
+    lanes = race.lanes(scene, "_2") + race.lanes(cluttered, "_50")
+    _race(lanes, reference)
 
     settle = min(5.0, steps * dt / 2)
     settled = np.arange(steps) * dt >= settle
@@ -84,7 +61,7 @@ def measure(steps: int) -> dict[str, Any]:
     m: dict[str, Any] = {"steps": steps, "dt_s": dt, "settle_s": settle, "obstacles": 50,
                          "clutter_distance_m": distance,
                          "clutter_within_reach": int(within)}  # fmt: skip
-    by_name = {lane.name: lane for lane in race}
+    by_name = {lane.name: lane for lane in lanes}
     for name in NAMES:
         for count in (2, 50):
             m[f"{name}_step_us_{count}"] = (
@@ -121,9 +98,7 @@ def with_clutter(scene: Scene, motion: list[np.ndarray]) -> tuple[Scene, float]:
         if closest >= CLEAR:
             added.append(candidate)
             least = min(least, closest)
-    cluttered = Scene(scene.robot, (*scene.obstacles, *added), scene.broadphase, scene.metric,
-                      scene.self_pair_names)  # fmt: skip
-    return cluttered, float(least)
+    return with_obstacles(scene, added), float(least)
 
 
 def table(m: dict[str, Any]) -> tuple[str, list[str], list[list[str]]]:

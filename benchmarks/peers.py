@@ -77,6 +77,7 @@ FAR_COUNTS = (0, 1, 2, 4, 8)
 FAR_RADIUS = 2.0  # [m] from the base axis; the iiwa14 reaches about 1.3 m
 NEAR_COUNTS = FAR_COUNTS
 NEAR_BAND = (0.3, 0.6)  # [m] from every link over the main race's motions
+SHOULDER = np.array([0.0, 0.0, 0.36])  # [m] the iiwa14's second joint: the centre of reach
 FAR_STEPS = 300  # periods of the far-obstacle race (fewer when --steps is smaller)
 WARMUP = 5  # periods run (and discarded) by each controller before the race: JIT, caches
 NAMES = ("qp", "improved", "mink")
@@ -93,46 +94,91 @@ class Lane:
     qs: list[np.ndarray] = field(default_factory=list)
 
 
-def measure(steps: int) -> dict[str, Any]:
-    """Run the races and return the measures (see the module's docstring)."""
-    from articula.bench.mink_peer import MinkArm, matched_gain  # pip install -e '.[peers]'
+@dataclass(frozen=True)
+class BookRace:
+    """The book's two-obstacle circle as the races run it: the scene, the start, articula's
+    controllers' settings (speed limits, INFLUENCE) and the reference.
 
+    Attributes:
+        scene: the iiwa14 and the bracket and rock.
+        q0: the start, shape (7,) [rad].
+        specs: "qp" and "improved" -> their [planner] settings.
+        seed: the scene file's seed.
+        targets: the reference, t [s] -> target.
+    """
+
+    scene: Scene
+    q0: np.ndarray
+    specs: dict[str, PlannerSpec]
+    seed: int
+    targets: Callable[[float], Any]
+
+    @classmethod
+    def load(cls) -> BookRace:
+        """The packaged circle_two_obstacles.toml, its planner with the speed limits."""
+        path = packaged("ch1", SCENE)
+        data = load_toml(path)
+        table = {**data["planner"], "limits": "velocity", "influence": INFLUENCE}
+        plan = build_plan({**data, "planner": table}, path.parent, str(path))
+        specs = {name: PlannerSpec(**{**table, "method": method})
+                 for name, method in (("qp", "qp"), ("improved", "baornn-improved"))}  # fmt: skip
+        return cls(plan.scene, plan.q0, specs, plan.config.seed, plan.targets)
+
+    @property
+    def d_min(self) -> float:
+        """The hard minimum distance [m]."""
+        return self.specs["qp"].d_min
+
+    @property
+    def dt(self) -> float:
+        """The control period [s]."""
+        return self.specs["qp"].dt
+
+    def reference(self, steps: int) -> np.ndarray:
+        """The reference positions of the first `steps` periods, shape (steps, 3) [m]."""
+        return np.array([self.targets(n * self.dt).position for n in range(steps)])
+
+    def lanes(self, scene: Scene, suffix: str = "", gain: float | None = None) -> list[Lane]:
+        """Warmed-up qp, improved and mink lanes on `scene` (their names ending in `suffix`),
+        and mink_matched with the collision gain `gain` when one is given."""
+        from articula.bench.mink_peer import MinkArm  # pip install -e '.[peers]'
+
+        q0, d_min, dt = self.q0, self.d_min, self.dt
+        out = [Lane(f"{name}{suffix}", _articula(scene, self.specs[name], self.seed, q0))
+               for name in ("qp", "improved")]  # fmt: skip
+        out.append(Lane(f"mink{suffix}", _mink(MinkArm(scene, d_min, INFLUENCE, dt), q0)))
+        if gain is not None:
+            arm = MinkArm(scene, d_min, INFLUENCE, dt, gain=gain)
+            out.append(Lane(f"mink_matched{suffix}", _mink(arm, q0)))
+        return out
+
+
+def check_steps(steps: int) -> None:
+    """Refuse fewer than two periods (exit 2, one line)."""
     if steps < 2:
         print("error: --steps must be at least 2", file=sys.stderr)
         raise SystemExit(2)
 
-    path = packaged("ch1", SCENE)
-    data = load_toml(path)
-    table = {**data["planner"], "limits": "velocity", "influence": INFLUENCE}
-    plan = build_plan({**data, "planner": table}, path.parent, str(path))
-    scene, q0, targets = plan.scene, plan.q0, plan.targets
-    specs = {
-        "qp": PlannerSpec(**{**table, "method": "qp"}),
-        "improved": PlannerSpec(**{**table, "method": "baornn-improved"}),
-    }
-    d_min, dt = specs["qp"].d_min, specs["qp"].dt
-    seed = plan.config.seed
-    reference = np.array([targets(n * dt).position for n in range(max(steps, FAR_STEPS))])
+
+def measure(steps: int) -> dict[str, Any]:
+    """Run the races and return the measures (see the module's docstring)."""
+    from articula.bench.mink_peer import matched_gain  # pip install -e '.[peers]'
+
+    check_steps(steps)
+    race = BookRace.load()
+    scene, d_min, dt = race.scene, race.d_min, race.dt
+    reference = race.reference(max(steps, FAR_STEPS))
     # A damper like the qp's (1 m/s over the detection band) in mink's units.
     gain = matched_gain(dt, d_min, INFLUENCE)
-
-    def lanes(s: Scene, matched: bool = False) -> list[Lane]:
-        out = [Lane(name, _articula(s, specs[name], seed, q0)) for name in ("qp", "improved")]
-        out.append(Lane("mink", _mink(MinkArm(s, d_min, INFLUENCE, dt), q0)))
-        if matched:
-            arm = MinkArm(s, d_min, INFLUENCE, dt, gain=gain)
-            out.append(Lane("mink_matched", _mink(arm, q0)))
-        return out
-
-    main = lanes(scene, matched=True)
+    main = race.lanes(scene, gain=gain)
     _race(main, reference[:steps])
     far_steps = min(steps, FAR_STEPS)
     far_scenes = {n: with_far_obstacles(scene, n) for n in FAR_COUNTS}
-    far = {n: lanes(s) for n, s in far_scenes.items()}
+    far = {n: race.lanes(s) for n, s in far_scenes.items()}
     _race([lane for n in FAR_COUNTS for lane in far[n]], reference[:far_steps])
     motion = [q for lane in main for q in lane.qs[::10]]
     near_scenes, near_distance = with_near_obstacles(scene, max(NEAR_COUNTS), motion)
-    near = {n: lanes(near_scenes[n]) for n in NEAR_COUNTS}
+    near = {n: race.lanes(near_scenes[n]) for n in NEAR_COUNTS}
     _race([lane for n in NEAR_COUNTS for lane in near[n]], reference[:far_steps])
 
     settle = min(5.0, steps * dt / 2)
@@ -208,6 +254,11 @@ def with_far_obstacles(scene: Scene, count: int) -> Scene:
         pose = np.eye(4)
         pose[:3, 3] = [FAR_RADIUS * np.cos(angle), FAR_RADIUS * np.sin(angle), 0.5]
         extra.append(Obstacle(f"far{k}", small, pose))
+    return with_obstacles(scene, extra)
+
+
+def with_obstacles(scene: Scene, extra: Sequence[Obstacle]) -> Scene:
+    """`scene` (its broad phase, metric and self pairs) with the `extra` obstacles added."""
     return Scene(scene.robot, (*scene.obstacles, *extra), scene.broadphase, scene.metric,
                  scene.self_pair_names)  # fmt: skip
 
@@ -226,7 +277,7 @@ def with_near_obstacles(
     while len(placed) < count:
         pose = np.eye(4)
         pose[:3, 3] = rng.uniform([-1.2, -1.2, 0.0], [1.2, 1.2, 1.4])
-        if np.linalg.norm(pose[:3, 3] - [0.0, 0.0, 0.36]) > 1.2 or any(
+        if np.linalg.norm(pose[:3, 3] - SHOULDER) > 1.2 or any(
             np.linalg.norm(pose[:3, 3] - o.pose[:3, 3]) < 0.3 for o in placed
         ):
             continue
@@ -236,11 +287,7 @@ def with_near_obstacles(
         if NEAR_BAND[0] <= closest <= NEAR_BAND[1]:
             placed.append(candidate)
             distances.append(closest)
-    scenes = {}
-    for n in NEAR_COUNTS:
-        obstacles = (*scene.obstacles, *placed[:n])
-        scenes[n] = Scene(scene.robot, obstacles, scene.broadphase, scene.metric,
-                          scene.self_pair_names)  # fmt: skip
+    scenes = {n: with_obstacles(scene, placed[:n]) for n in NEAR_COUNTS}
     return scenes, [min(distances, default=0.0), max(distances, default=0.0)]
 
 

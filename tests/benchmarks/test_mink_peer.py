@@ -4,10 +4,6 @@ benchmarks/peers.py runs (skipped without the `peers` extra)."""
 from __future__ import annotations
 
 import importlib
-import json
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,12 +13,12 @@ from articula.book.study import packaged
 from articula.planning.trajectories import Circle
 from articula.scene.config import build_scene, load_scene_spec
 from articula.validation import load_toml
+from tests.benchmarks.run import benchmark
 
 INSTALL = "pip install -e '.[peers]'"
 pytest.importorskip("mujoco", reason=INSTALL)
 pytest.importorskip("mink", reason=INSTALL)
 
-BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
 peer = importlib.import_module("articula.bench.mink_peer")
 mink_model = importlib.import_module("articula.bench.mink_model")
 
@@ -140,15 +136,7 @@ def test_mink_keeps_d_min_past_the_bracket_with_a_damper_gain(scene_q0):
 
 
 def test_peers_benchmark_prints_its_keys_as_one_json_object():
-    proc = subprocess.run(
-        [sys.executable, str(BENCHMARKS / "peers.py"), "--json", "--steps", "50"],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        check=False,
-    )
-    assert proc.returncode == 0, proc.stderr
-    m = json.loads(proc.stdout)
+    m = benchmark("peers.py", "--steps", "50")
     keys = ["qp_step_us", "improved_step_us", "mink_step_us", "qp_vs_mink", "improved_vs_mink",
             "qp_per_far_obstacle_us", "improved_per_far_obstacle_us", "mink_per_far_obstacle_us",
             "qp_rms_m", "improved_rms_m", "mink_rms_m", "qp_min_clearance_m",
@@ -165,15 +153,7 @@ def test_peers_benchmark_prints_its_keys_as_one_json_object():
 
 
 def test_clutter_benchmark_prints_its_keys_as_one_json_object():
-    proc = subprocess.run(
-        [sys.executable, str(BENCHMARKS / "clutter.py"), "--json", "--steps", "40"],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        check=False,
-    )
-    assert proc.returncode == 0, proc.stderr
-    m = json.loads(proc.stdout)
+    m = benchmark("clutter.py", "--steps", "40")
     assert m["obstacles"] == 50 and m["clutter_distance_m"] >= 0.2
     for name in ("qp", "improved", "mink"):
         assert m[f"{name}_clutter_ratio"] == pytest.approx(
