@@ -12,9 +12,12 @@ from articula.planning.baornn import Baornn, BaornnParams
 from articula.planning.baornn_improved import ImprovedBaornn, ImprovedParams
 from articula.planning.objective import Objective
 from tests.planning.helpers import CIRCLE, DT, ROBOT, ball, rms_after
+from tests.scene.helpers import book_scene
 
 SCENE_BALL = ([0.35, 0.35, 0.6], 0.08)  # beside the elbow on the way to the circle
 PARAMS = ImprovedParams(c1=0.3, c2=0.5, pairs=3, iterations_per_step=10)
+# Changes 1-5 alone: no Gauss-Newton candidate, every iteration run (changes 6 and 7 off).
+SEARCH_ONLY = PARAMS.model_copy(update={"newton_damping": 0.0, "quiet_error": 0.0})
 
 
 @pytest.fixture
@@ -70,17 +73,17 @@ def test_short_antennae_refine_what_the_long_ones_overshoot(objective):
     for seed in (0, 1, 2):
         errors = {}
         for short in (1.0, 0.25):
-            params = PARAMS.model_copy(update={"short_antenna": short})
+            params = SEARCH_ONLY.model_copy(update={"short_antenna": short})
             planner = ImprovedBaornn(objective, params, np.random.default_rng(seed))
             errors[short] = rms_after(track(planner, CIRCLE, q0, DT, 6.0), 3.0)
         assert errors[0.25] < 0.7 * errors[1.0], (seed, errors)
 
 
 def test_clear_of_the_yield_distance_a_period_never_raises_the_task_error(objective):
-    # Change 5; with yield_distance = inf (the book's acceptance) the penalty does raise it.
+    # Change 5; with yield_distance = inf (the book's acceptance) the search does raise it.
     raised = {}
     for yield_distance in (0.03, np.inf):
-        params = PARAMS.model_copy(update={"yield_distance": yield_distance})
+        params = SEARCH_ONLY.model_copy(update={"yield_distance": yield_distance})
         planner = ImprovedBaornn(objective, params, np.random.default_rng(2))
         q, raised[yield_distance] = np.zeros(ROBOT.nq), []
         for n in range(300):
@@ -94,11 +97,48 @@ def test_clear_of_the_yield_distance_a_period_never_raises_the_task_error(object
     assert any(raised[np.inf])
 
 
+def test_where_the_penalty_is_flat_a_period_stops_on_the_path_and_nowhere_else():
+    # Changes 6 and 7 with Λ = 5e-5 (flat beyond 22 mm; the ball stays ≥ 66 mm away): a period
+    # that runs fewer than iterations_per_step iterations ends within quiet_error of the path.
+    objective = Objective(ball(*SCENE_BALL), 5e-5, 1.0, d_min=0.002)
+    planner = ImprovedBaornn(objective, PARAMS, np.random.default_rng(3))
+    q, short = np.zeros(ROBOT.nq), 0
+    for n in range(300):
+        before = planner.iterations
+        q = planner.step(q, CIRCLE(DT * n), DT * n)
+        if planner.iterations - before < PARAMS.iterations_per_step:
+            short += 1
+            assert objective.tracking_error(q, CIRCLE(DT * n)) < PARAMS.quiet_error
+    assert short > 150  # measured: most periods once on the path
+    search_only = ImprovedBaornn(objective, SEARCH_ONLY, np.random.default_rng(3))
+    r = track(search_only, CIRCLE, np.zeros(ROBOT.nq), DT, 3.0)
+    assert planner.evaluations < 0.5 * search_only.evaluations
+    assert objective.tracking_error(q, CIRCLE(DT * 299)) < rms_after(r, 2.0)
+
+
+def test_where_the_penalty_is_steep_a_period_is_the_search_alone():
+    # Λ = 0.005 on the book's two obstacles (slope > 0.1 below 224 mm): bit for bit changes 1-5.
+    objective = Objective(book_scene("circle_two_obstacles"), 0.005, 1.0, d_min=0.002)
+    runs = []
+    for params in (PARAMS, SEARCH_ONLY):
+        planner = ImprovedBaornn(objective, params, np.random.default_rng(4))
+        q, qs = np.zeros(ROBOT.nq), []
+        for n in range(150):
+            if objective.scene.clearances(q)[0] >= np.sqrt(0.005 / 0.1):
+                break  # flat from here on
+            q = planner.step(q, CIRCLE(DT * n), DT * n)
+            qs.append(q)
+        runs.append(np.array(qs))
+    assert len(runs[0]) > 50 and np.array_equal(runs[0], runs[1])
+
+
 @pytest.mark.parametrize(
     ("kwargs", "field"),
     [({"pairs": 0}, "ImprovedParams.pairs"), ({"c1": -1.0}, "ImprovedParams.c1"),
      ({"short_antenna": 0.0}, "ImprovedParams.short_antenna"),
-     ({"yield_distance": -0.01}, "ImprovedParams.yield_distance")],
+     ({"yield_distance": -0.01}, "ImprovedParams.yield_distance"),
+     ({"quiet_error": -1e-5}, "ImprovedParams.quiet_error"),
+     ({"newton_damping": np.nan}, "ImprovedParams.newton_damping")],
 )  # fmt: skip
 def test_bad_params_name_the_class_and_field(kwargs, field):
     with pytest.raises(ConfigError) as exc:

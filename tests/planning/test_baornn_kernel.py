@@ -13,18 +13,24 @@ from articula.planning.baornn_improved import ImprovedBaornn, ImprovedParams
 from articula.planning.objective import Objective
 from articula.planning.task import as_target
 from articula.scene.config import build_scene, load_scene_spec
-from tests.planning.helpers import CIRCLE, ROBOT
+from articula.scene.scene import Scene
+from tests.planning.helpers import CIRCLE, ROBOT, ball
 from tests.scene.helpers import book_scene
 
+BALL = ([0.35, 0.35, 0.6], 0.08)  # beside the elbow on the way to the circle
 
-def _both_paths(make_planner, periods: int) -> tuple[np.ndarray, list]:
+
+def _both_paths(
+    make_planner, periods: int, penalty: float = 0.005, scene: Scene | None = None
+) -> tuple[np.ndarray, list]:
     """q after each of `periods` control periods of 10 ms along the book circle, from home, for
     the planner make_planner(objective, rng) on the compiled and on the coal objective (Λ =
-    0.005, β = 1, d_min = 2 mm, seed 4); returns both q series and both planners."""
-    scene = book_scene("circle_two_obstacles")
+    `penalty`, β = 1, d_min = 2 mm, seed 4) of `scene` (None: the book's two obstacles);
+    returns both q series and both planners."""
+    scene = scene or book_scene("circle_two_obstacles")
     runs, planners = [], []
     for compiled in (True, False):
-        objective = Objective(scene, 0.005, 1.0, 0.002, use_compiled=compiled)
+        objective = Objective(scene, penalty, 1.0, 0.002, use_compiled=compiled)
         planner = make_planner(objective, np.random.default_rng(4))
         q = np.zeros(ROBOT.nq)
         qs = []
@@ -55,6 +61,18 @@ def test_compiled_improved_variant_follows_its_python_loop():
         assert planner.iterations == 40
     assert np.allclose(runs[0][:4], runs[1][:4], atol=1e-8)
     assert np.allclose(runs[0], runs[1], atol=1e-5)
+
+
+def test_compiled_newton_candidate_and_quiet_stop_follow_the_python_loop():
+    # Λ = 5e-5 beside a ball ≥ 66 mm away: the penalty is flat beyond 22 mm, so changes 6
+    # and 7 act; the Jacobians (compiled chain, Pinocchio) agree to round-off.
+    params = ImprovedParams(c1=0.3, c2=0.5, pairs=3, iterations_per_step=4)
+    runs, planners = _both_paths(
+        lambda objective, rng: ImprovedBaornn(objective, params, rng), 300, 5e-5, ball(*BALL)
+    )
+    assert planners[0].iterations == planners[1].iterations < 1000  # periods stopped
+    assert planners[0].evaluations == planners[1].evaluations
+    assert np.allclose(runs[0], runs[1], atol=1e-6)
 
 
 def test_a_point_closer_to_itself_than_the_margin_is_outside_omega_on_every_path():

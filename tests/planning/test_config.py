@@ -30,7 +30,9 @@ BASELINE = {"dt": 0.02, "d_min": 0.003, "gain": 12.0, "influence": 0.2, "safety"
     ("method", "kind"), [("baornn", Baornn), ("baornn-improved", ImprovedBaornn)]
 )
 def test_make_planner_builds_a_beetle_search_on_the_spec_objective(method, kind):
-    spec = PlannerSpec(method=method, pairs=5, short_antenna=0.5, yield_distance=0.04, **BEETLE)
+    improved = {"pairs": 5, "short_antenna": 0.5, "yield_distance": 0.04, "newton_damping": 0.01,
+                "quiet_error": 2e-5, "flat_penalty_slope": 0.2}  # fmt: skip
+    spec = PlannerSpec(method=method, **improved, **BEETLE)
     planner = make_planner(spec, SCENE, seed=0)
     assert type(planner) is kind
     assert planner.scene is SCENE
@@ -39,7 +41,9 @@ def test_make_planner_builds_a_beetle_search_on_the_spec_objective(method, kind)
     params = planner.params
     assert (params.c1, params.c2, params.iterations_per_step) == (0.2, 0.7, 4)
     if method == "baornn-improved":
-        assert (params.pairs, params.short_antenna, params.yield_distance) == (5, 0.5, 0.04)
+        # Every field of ImprovedParams is a [planner] key, and each one reaches it.
+        assert set(type(params).model_fields) <= set(PlannerSpec.model_fields)
+        assert {k: getattr(params, k) for k in improved} == improved
 
 
 def test_make_planner_builds_the_qp_baseline():

@@ -10,6 +10,7 @@ __all__ = [
     "baornn_kernel",
     "clearance",
     "config",
+    "newton_step",
     "objective",
     "planner",
     "qp_ik",

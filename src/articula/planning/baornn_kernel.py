@@ -12,6 +12,7 @@ from typing import NamedTuple
 import numpy as np
 
 from articula.numba_cache import jit
+from articula.planning.newton_step import newton_from_chain, penalty_flat
 from articula.planning.rate_limits import braking_after, braking_path
 from articula.planning.task import orientation_error
 from articula.scene.compiled_clearance import _evaluate
@@ -278,13 +279,15 @@ def _orthonormal_columns(draw):
 
 @jit()
 def improved_period(q, g_known, warm_motion, reference, draws, c1, c2, short, yield_distance,
-                    problem):  # fmt: skip
+                    damping, quiet_error, flat_slope, problem):  # fmt: skip
     """One control period of baornn-improved (planning/baornn_improved.py): g at q for the
     new reference (inf outside Ω; g_known instead when it is not NaN: a caller's g(q)), the
-    warm start q + warm_motion (none when it is empty), then one iteration per draws[k], an
+    warm start q + warm_motion (none when it is empty), the Gauss-Newton candidate
+    (planning/newton_step.py; none when damping is 0), then one iteration per draws[k], an
     (n × pairs) Gaussian matrix whose orthonormalised columns are the antenna directions.
     While q is at least yield_distance clear, no accepted point has a larger task error than
-    q has (tracking_cap).
+    q has (tracking_cap). Where the penalty is flat there (penalty_flat), the Gauss-Newton
+    candidate is tried and the iterations end once the accepted error is below quiet_error.
 
     Args:
         q: joint angles at the start of the period, shape (nq,) [rad].
@@ -296,11 +299,14 @@ def improved_period(q, g_known, warm_motion, reference, draws, c1, c2, short, yi
         c2: step constant of Eq. (1.24).
         short: relative length of every second antenna pair.
         yield_distance: the clearance below which the task error may grow [m].
+        damping: μ of the Gauss-Newton candidate [m]; 0: no candidate.
+        quiet_error: task error below which a period stops iterating [m].
+        flat_slope: the penalty's slope below which it counts as flat [-].
         problem: g's weights and Ω (Problem, packed: Objective.problem).
 
     Returns:
-        The accepted joint angles, shape (nq,) [rad], their objective g, and the number of
-        objective evaluations.
+        The accepted joint angles, shape (nq,) [rad], their objective g, the number of
+        objective evaluations and the number of iterations run.
     """
     reference, problem = Reference(*reference), Problem(*problem)
     d, d_self, ee, ee_R = _evaluate(q, problem.clearance, problem.static_min)
@@ -312,15 +318,27 @@ def improved_period(q, g_known, warm_motion, reference, draws, c1, c2, short, yi
     ):
         g = math.inf  # a start outside Ω: any point inside it is better
     cap = tracking_cap(e, g, d, yield_distance)
+    flat = penalty_flat(d, problem.lambda_weight, problem.beta, flat_slope)
     evaluations = 0
     if warm_motion.size:
         q_warm, g_warm, e_warm = _project_and_value(q + warm_motion, q, g, e, reference, problem)
         evaluations += 1
         if g_warm < g and e_warm <= cap:
             q, g, e = q_warm, g_warm, e_warm
+    if flat and damping > 0.0:
+        q_newton = newton_from_chain(q, reference, problem.clearance, damping, problem.lower,
+                                     problem.upper)  # fmt: skip
+        q_gn, g_gn, e_gn = _project_and_value(q_newton, q, g, e, reference, problem)
+        evaluations += 1
+        if g_gn < g and e_gn <= cap:
+            q, g, e = q_gn, g_gn, e_gn
     n = q.size
     longest = antenna_cap(problem.lower, problem.upper)
+    run = 0
     for k in range(draws.shape[0]):
+        if flat and e < quiet_error:
+            break  # on the path: the penalty has nothing to trade against (change 7)
+        run += 1
         lam = min(c1 * math.sqrt(e), longest)  # c1·√e_k, e_k the task error at the accepted q
         directions = _orthonormal_columns(draws[k])
         gradient = np.zeros(n)
@@ -349,4 +367,4 @@ def improved_period(q, g_known, warm_motion, reference, draws, c1, c2, short, yi
             if g_new < best_g and e_new <= cap:  # Eqs. (1.21)-(1.22)
                 best_q, best_g, best_e = q_new, g_new, e_new
         q, g, e = best_q, best_g, best_e
-    return q, g, evaluations
+    return q, g, evaluations, run

@@ -134,6 +134,11 @@ class PlannerSpec(StrictModel):
         yield_distance: clearance below which baornn-improved may leave the path to keep
             clear; above it the penalty moves the arm through the redundancy only; inf: the
             book's acceptance [m].
+        newton_damping: μ of baornn-improved's Gauss-Newton candidate; 0: none [m].
+        quiet_error: task error below which a baornn-improved period stops iterating where
+            the penalty is flat; 0: never early [m].
+        flat_penalty_slope: the penalty slope Λβ/d^(β+1) below which baornn-improved tries
+            the Gauss-Newton step and may stop early; 0: never [-].
         gain: K on the task error, baselines [1/s].
         damping: μ of damped least squares, dls [m].
         repulsion: η of the obstacle repulsion, pinv and dls [m²/s].
@@ -177,6 +182,9 @@ class PlannerSpec(StrictModel):
     pairs: Annotated[int, Field(ge=1, le=64)] = 3
     short_antenna: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.25
     yield_distance: Annotated[float, Field(ge=0)] = 0.03
+    newton_damping: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.02
+    quiet_error: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 1e-5
+    flat_penalty_slope: Annotated[float, Field(ge=0)] = 0.1
     gain: NonNegative = 20.0
     damping: NonNegative = 0.02
     repulsion: NonNegative = 0.02
@@ -244,28 +252,21 @@ def _planner(spec: PlannerSpec, scene: Scene, seed: int) -> Planner:
     objective = Objective(scene, spec.lambda_weight, spec.beta, spec.d_min, task=task)
     rate = rate_limits(spec, scene.robot)
     if spec.method == "baornn":
-        params = BaornnParams(c1=spec.c1, c2=spec.c2, iterations_per_step=spec.iterations_per_step)
-        return Baornn(objective, params, rng, rate)
+        return Baornn(objective, _params(BaornnParams, spec), rng, rate)
     if spec.method == "baornn-improved":
-        # Every ImprovedParams field has a [planner] key of its name.
-        improved = ImprovedParams(**{k: getattr(spec, k) for k in ImprovedParams.model_fields})
-        return ImprovedBaornn(objective, improved, rng, rate)
+        return ImprovedBaornn(objective, _params(ImprovedParams, spec), rng, rate)
     if spec.method == "qp":
-        qp = QpIkParams(
-            gain=spec.gain,
-            influence=spec.influence,
-            safety=spec.safety,
-            speed_scale=spec.velocity_scale,
-        )
+        qp = _params(QpIkParams, spec, speed_scale=spec.velocity_scale)
         return QpIk(scene, spec.dt, qp, d_min=spec.d_min, task=task, rate=rate)
-    velocity = VelocityIkParams(
-        gain=spec.gain,
-        damping=spec.damping,
-        repulsion=spec.repulsion,
-        influence=spec.influence,
-        speed_scale=spec.velocity_scale,
-    )
+    velocity = _params(VelocityIkParams, spec, speed_scale=spec.velocity_scale)
     return VelocityIk(scene, spec.method, spec.dt, velocity, d_min=spec.d_min, task=task, rate=rate)
+
+
+def _params(model: type[StrictModel], spec: PlannerSpec, **extra: Any) -> Any:
+    """`model` from the [planner] keys named as its fields (the rest its defaults), and
+    `extra`."""
+    keys = {k: getattr(spec, k) for k in model.model_fields if k in PlannerSpec.model_fields}
+    return model(**keys, **extra)
 
 
 def rate_limits(spec: PlannerSpec, robot: RobotModel) -> RateLimits | None:
