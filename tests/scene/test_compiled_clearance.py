@@ -133,3 +133,6 @@ def test_near_pairs_keep_every_pair_that_can_be_the_minimum_in_the_box():
     assert dropped["reach"] >= 30 * 4 * 7  # the far spheres' pairs, at least, left every box
     # Per joint, the box's distal joints count for what they move: more pairs left out.
     assert dropped["sweep"] > 1.2 * dropped["reach"]
+    # The nearest pair's exact distance at the centre caps the ceiling: 1235 and 1750 pairs
+    # left out over these boxes, against 1107 and 1697 with the balls around a vertex alone.
+    assert dropped["reach"] > 1200 and dropped["sweep"] > 1740
