@@ -13,6 +13,7 @@ from articula.geometry.shapes import box
 from articula.loops.tracking import track
 from articula.planning import qp_ik
 from articula.planning.qp_ik import QpIk, QpIkParams
+from articula.planning.rate_limits import RateLimits
 from articula.scene import Obstacle, Scene
 from tests.planning.helpers import (
     CIRCLE,
@@ -48,14 +49,13 @@ def test_qp_dampers_keep_clearance_with_an_obstacle_across_the_approach():
 
 def test_qp_counts_the_periods_without_a_solution_and_stays_put(monkeypatch):
     solve = qp_ik.daqp.solve
-    calls = {"n": 0}
 
-    def every_third_fails(*args, **kwargs):
-        calls["n"] += 1
+    def every_third_period_fails(*args, **kwargs):
         x, value, status, info = solve(*args, **kwargs)
-        return x, value, -1 if calls["n"] % 3 == 0 else status, info  # -1: infeasible
+        failing = planner.iterations % 3 == 2  # both the solve and its relaxed retry
+        return x, value, -1 if failing else status, info  # -1: infeasible
 
-    monkeypatch.setattr(qp_ik.daqp, "solve", every_third_fails)
+    monkeypatch.setattr(qp_ik.daqp, "solve", every_third_period_fails)
     planner = QpIk(FREE, DT)
     q = np.zeros(ROBOT.nq)
     moved = []
@@ -92,3 +92,23 @@ def test_speed_scale_must_be_positive():
     with pytest.raises(ConfigError, match="speed_scale") as exc:
         QpIkParams(speed_scale=0.0)
     assert exc.value.field == "QpIkParams.speed_scale"
+
+
+@pytest.mark.parametrize("start_clearance", [0.015, 0.005])
+def test_qp_starts_from_inside_its_dampers_safety_distance(start_clearance):
+    # A ball 15 mm (or 5 mm) from the arm at rest: inside the 30 mm safety distance, outside
+    # d_min. Under jerk limits no first period can push every damper's row out as fast as it
+    # asks; the dampers then ask only that the arm not approach, and it sets off.
+    q0 = np.zeros(ROBOT.nq)
+    centre = np.array([0.2, 0.0, 0.6])
+    for _ in range(5):  # move the ball along x until the start's clearance is as asked
+        centre[0] += start_clearance - ball(centre, 0.05).clearances(q0)[0]
+    scene = ball(centre, 0.05)
+    assert scene.clearances(q0)[0] == pytest.approx(start_clearance, abs=1e-6)
+    assert start_clearance < QpIkParams().safety
+    rate = RateLimits(ROBOT.velocity_limit, DT, ROBOT.acceleration_limit, ROBOT.jerk_limit)
+    planner = QpIk(scene, DT, d_min=0.002, rate=rate)
+    r = track(planner, CIRCLE, q0, DT, 6.0)
+    assert r.error[-1] < 1e-3  # it left the start and reached the circle
+    assert r.clearance.min() > 0.002
+    assert planner.infeasible < 0.1 * len(r.t)

@@ -16,7 +16,10 @@ Problem i of seed S draws everything from numpy.random.default_rng([S, i]):
 Obstacles near the links' swept volume force the redundancy to be used; the path itself stays
 free, so a controller that keeps clear can still track it. The "tight" class (issue 31) puts
 2-4 obstacles each TIGHT_GAP (2-5 cm) from the links over the whole obstacle-free motion: that
-motion stays clear, but every method's dampers or penalty act on it throughout.
+motion stays clear, but every method's dampers or penalty act on it throughout. The "grazing"
+class (issue 42) puts 1-2 obstacles each GRAZING_GAP from the links over that motion, whose
+closest approach is within d_min (up to 1 cm into a link): the obstacle-free motion breaks
+d_min, so a method tracks only if it moves the links around the obstacle along d_min.
 """
 
 from __future__ import annotations
@@ -56,7 +59,16 @@ START_SELF_CLEARANCE = 0.01  # [m] between checked links at q0 (the Panda's wris
 PATH_CLEARANCE = 0.06  # [m] from every obstacle's bounding sphere to the path
 REACH_RMS = 0.0005  # [m] obstacle-free DLS tracking that shows a path reachable
 TIGHT_GAP = (0.02, 0.05)  # [m] the tight class: each obstacle's clearance from the motion
-CLASSES = ("standard", "tight")
+GRAZING_GAP = (-0.01, D_MIN)  # [m] the grazing class: the same, within d_min
+CLASSES = ("standard", "tight", "grazing")
+# Each class: (fewest obstacles, most obstacles + 1, placement gap from the chosen surface
+# point [m], the closest approach over the obstacle-free motion each obstacle must keep, or
+# None) [m].
+PLACEMENT = {
+    "standard": (1, 5, (-0.02, 0.05), None),
+    "tight": (2, 5, TIGHT_GAP, TIGHT_GAP),
+    "grazing": (1, 3, GRAZING_GAP, GRAZING_GAP),
+}
 ATTEMPTS = 100  # draws of a start, path or obstacle before the problem is given up
 # The suite's common settings, and BAORNN's. Its penalty Λ/d (Eq. 1.11, β = 1) pulls harder
 # than the tracking term (|∂(Λ/d)/∂d| > 1) within √Λ of an obstacle, so Λ sets how near a
@@ -109,7 +121,8 @@ def generate(
         robot_table: a [robot] table with absolute paths; its q0, if any, is replaced.
         seed: the suite's seed.
         index: the problem's index; it draws from default_rng([seed, index]).
-        problem_class: "standard", or "tight" (obstacles TIGHT_GAP from the links).
+        problem_class: "standard", "tight" (obstacles TIGHT_GAP from the links) or
+            "grazing" (obstacles the obstacle-free motion passes within d_min of).
 
     Returns:
         The problem.
@@ -126,8 +139,7 @@ def generate(
         if motion is None:
             continue
         reference = np.array([targets(t).position for t in np.arange(0.0, duration, DT)])
-        tight = problem_class == "tight"
-        obstacles, meshes = _obstacles(robot, q0, motion, reference, rng, tight)
+        obstacles, meshes = _obstacles(robot, q0, motion, reference, rng, problem_class)
         if obstacles is None:
             continue
         planner = {**PLANNER, "duration": duration, "seed": seed}
@@ -208,14 +220,15 @@ def _obstacles(
     motion: np.ndarray,
     reference: np.ndarray,
     rng: np.random.Generator,
-    tight: bool,
+    problem_class: str,
 ) -> tuple[list[dict[str, Any]] | None, dict[str, trimesh.Trimesh]]:
-    """1-4 obstacles beside the motion's links (tight: 2-4, each TIGHT_GAP from them over the
-    whole motion), as [[obstacles]] tables and mesh files; None when one cannot be placed."""
+    """The class's obstacles beside the motion's links (PLACEMENT: standard 1-4; tight 2-4,
+    each TIGHT_GAP from them over the whole motion; grazing 1-2, each GRAZING_GAP), as
+    [[obstacles]] tables and mesh files; None when one cannot be placed."""
     tables, meshes, placed = [], {}, []
     links = [link for link in robot.links if robot.model.frames[link.frame_id].parentJoint != 0]
-    gap = TIGHT_GAP if tight else (-0.02, 0.05)  # [m] from the chosen surface point
-    for k in range(int(rng.integers(2 if tight else 1, 5))):
+    fewest, most, gap, closest = PLACEMENT[problem_class]
+    for k in range(int(rng.integers(fewest, most))):
         kind = ("rock", "box", "sphere", "capsule")[int(rng.integers(4))]
         for _ in range(ATTEMPTS):
             shape, table, mesh = _shape(kind, float(rng.uniform(0.03, 0.08)), rng)
@@ -236,7 +249,7 @@ def _obstacles(
             obstacle = Obstacle(f"{kind}{k}", (shape,), pose(centre, rpy))
             if Scene(robot, [*placed, obstacle]).clearances(q0)[0] <= START_CLEARANCE:
                 continue
-            if tight and not _within_gap(Scene(robot, [obstacle]), motion):
+            if closest is not None and not _within_gap(Scene(robot, [obstacle]), motion, closest):
                 continue
             placed.append(obstacle)
             name = f"{kind}{k}"
@@ -250,10 +263,11 @@ def _obstacles(
     return tables, meshes
 
 
-def _within_gap(scene: Scene, motion: np.ndarray) -> bool:
-    """Whether the scene's one obstacle is within TIGHT_GAP of the links over the motion."""
+def _within_gap(scene: Scene, motion: np.ndarray, gap: tuple[float, float]) -> bool:
+    """Whether the scene's one obstacle's closest approach to the links over the motion is
+    within `gap` [m]."""
     closest = min(scene.clearances(q)[0] for q in motion)
-    return TIGHT_GAP[0] <= closest <= TIGHT_GAP[1]
+    return gap[0] <= closest <= gap[1]
 
 
 def _shape(

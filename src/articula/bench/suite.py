@@ -32,6 +32,7 @@ import tomli_w
 from articula.bench.problems import D_MIN, DT, INFLUENCE, SETTLE, generate
 from articula.errors import ArticulaError, ConfigError
 from articula.experiments.plan import PlanSetup, build_plan
+from articula.loops.stall import standing_still
 from articula.planning.config import METHODS
 from articula.runs import records
 from articula.runs.backends import check_backend, execute_all
@@ -41,6 +42,7 @@ ARTICULA_METHODS = METHODS
 PEER_METHODS = ("mink", "mink-matched")
 FAILURES = ("error", "collision", "joint_limits", "speed_limits", "tracking")
 SUCCESS_RMS = 0.001  # [m] after SETTLE
+STALLED_RUN = 0.1  # [s] a run that stood still this long off its path (settled) stalled
 PROBLEMS = "problems"
 PEERS_INSTALL = "pip install -e '.[peers]'"
 
@@ -229,6 +231,8 @@ def _run(method: str, plan: PlanSetup, targets: list) -> dict[str, Any]:
         "median_step_us": float(np.median(times[1:]) / 1e3),
         "p99_step_us": float(np.percentile(times[1:], 99) / 1e3),
     }
+    still = standing_still(robot, qs, q0, DT) & (error > SUCCESS_RMS)
+    metrics["stalled_s"] = float(np.sum(still[settled])) * DT
     failed = {
         "collision": metrics["colliding_steps"] > 0,
         "joint_limits": metrics["joint_limit_steps"] > 0,
@@ -265,9 +269,11 @@ def summarize(
     seed: int,
     problems: int,
 ) -> dict[str, Any]:
-    """Per method: success rate, failures by class, mean, median and p99 step time over all
-    its periods, median RMS error and the smallest clearance; and each articula method's
-    success rate less the better mink's and its mean step time over mink's (default gain).
+    """Per method: success rate, failures by class, stalls (runs that stood still off the
+    path, error above SUCCESS_RMS, for STALLED_RUN or longer once settled), mean, median and
+    p99 step time over all its periods, median RMS error and the smallest clearance; and each
+    articula method's success rate less the better mink's and its mean step time over mink's
+    (default gain).
 
     Args:
         rows: the rows of every problem and method (solve_problem), with their step_us.
@@ -296,6 +302,7 @@ def summarize(
         out["methods"][method] = {
             "success_rate": sum(r["success"] for r in mine) / max(len(mine), 1),
             "successes": sum(r["success"] for r in mine),
+            "stalls": sum((r.get("stalled_s") or 0.0) >= STALLED_RUN for r in mine),
             "failures": {f: sum(r["failure"] == f for r in mine) for f in FAILURES},
             "mean_step_us": statistics.fmean(times) if times else None,
             "median_step_us": statistics.median(times) if times else None,

@@ -109,9 +109,13 @@ def print_table(title: str, columns: tuple[str, ...], rows: list[tuple[str, ...]
     out.print(table)
 
 
-def metric_rows(metrics: dict[str, float | None]) -> list[tuple[str, str]]:
-    """A record's metrics as table rows, six significant digits, — where there is none."""
-    return [(k, "—" if v is None else f"{v:.6g}") for k, v in metrics.items()]
+def metric_rows(metrics: dict[str, float | str | None]) -> list[tuple[str, str]]:
+    """A record's metrics as table rows, six significant digits (a name as it is), — where
+    there is none."""
+    return [
+        (k, "—" if v is None else v if isinstance(v, str) else f"{v:.6g}")
+        for k, v in metrics.items()
+    ]
 
 
 def progress_bar(quiet: bool) -> Progress:

@@ -39,7 +39,9 @@ def plan(
 
     A motion with a colliding step (a link in an obstacle, or two links of a checked pair
     touching), or one the dynamics twin ([plant]) touches something in, still writes its run
-    folder, then exits with status 4.
+    folder, then exits with status 4; one that does not track its path (planner.tolerance)
+    writes it and exits with status 2, naming the cause measured (a stall at a boundary, a
+    start no step could leave, ...).
 
     \b
     Example: articula plan src/articula/book/ch1/configs/circle_two_obstacles.toml --out runs/circle
@@ -72,7 +74,15 @@ def plan(
             settled = (
                 f"{m['settle_s']:g} s into the path (after a {m['approach_s']:.2g} s approach)"
             )
-        out.print(f"RMS error {settled}: {error}; {clearance}; {speed}; written to {out_dir}")
+        stalled = f"; stalled {m['stalled_s']:.2f} s" if m.get("stalled_s") else ""
+        out.print(
+            f"RMS error {settled}: {error}; {clearance}{stalled}; {speed}; written to {out_dir}"
+        )
+    if not m.get("tracked", True):
+        from articula.errors import InfeasibleError
+
+        why = record["not_tracked"]
+        raise InfeasibleError(f"{why}; the run folder {out_dir} is written", f"{scene_file}")
     if m["collisions"] and not allow_collisions:
         from articula.errors import CollisionError
 

@@ -44,10 +44,14 @@ def run(
     record = run_to_folder(data, out_dir, where=str(config), force=force)
     if as_json:
         emit_json(record)
-        return
-    title = f"{record['experiment']} (seed {record['seed']})"
-    print_table(title, ("metric", "value"), metric_rows(record["metrics"]))
-    out.print(f"written to {out_dir}")
+    else:
+        title = f"{record['experiment']} (seed {record['seed']})"
+        print_table(title, ("metric", "value"), metric_rows(record["metrics"]))
+        out.print(f"written to {out_dir}")
+    if "not_tracked" in record:
+        from articula.errors import InfeasibleError
+
+        raise InfeasibleError(f"{record['not_tracked']}; the run folder {out_dir} is written")
 
 
 @app.command()

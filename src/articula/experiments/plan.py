@@ -19,10 +19,11 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import Field, model_validator
 
-from articula.errors import ConfigError, InfeasibleError
+from articula.errors import ConfigError
 from articula.limits import MAX_SERVO_SAMPLES
 from articula.loops.online import OnlineController
 from articula.loops.servo import run_stream, ticks_per_period
+from articula.loops.stall import not_tracked_cause, stall_metrics
 from articula.loops.tracking import trace_columns, track, tracking_metrics
 from articula.planning.approach import Approach, approach
 from articula.planning.config import (
@@ -248,14 +249,17 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
 
     Returns:
         The metrics of tracking_metrics (rms_error and max_error after `planner.settle` into
-            the path [m], clearances [m], collisions, limits, planner timings) and the trace
-            columns of trace_columns (t [s], phase, q_1..q_m [rad], x, y, z, their
-            references x_ref, y_ref, z_ref, error and clearance [m]).
+            the path [m], clearances [m], collisions, limits, planner timings) and of
+            loops.stall.stall_metrics (stalled_s [s], the stall's pair and clearance [m]),
+            `tracked` (False when rms_error after `planner.settle` exceeds
+            `planner.tolerance`, or, for a pose or axis task, rms_orientation_error
+            `planner.orientation_tolerance`: the record's `not_tracked` then says why, with
+            the cause measured); and the trace columns of trace_columns (t [s], phase,
+            q_1..q_m [rad], x, y, z, their references x_ref, y_ref, z_ref, error and
+            clearance [m]).
 
     Raises:
-        InfeasibleError: the path is out of the robot's reach, or its rms_error after
-            `planner.settle` exceeds `planner.tolerance` (or, for a pose or axis task, its
-            rms_orientation_error `planner.orientation_tolerance`).
+        InfeasibleError: the path is out of the robot's reach.
     """
     plan = build_plan(config, Path.cwd())
     p, lead = config.planner, plan.reference.duration
@@ -277,35 +281,38 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
     metrics = tracking_metrics(
         run, plan.scene.robot, p.settle or 0.0, planner.iterations, plan.targets.cone
     )
-    after = f"{p.settle} s into the path" if lead else f"{p.settle} s"
-    if metrics["rms_error"] > p.tolerance:
-        raise InfeasibleError(
-            f"not tracked: rms error {metrics['rms_error']:.3g} m after {after} (max "
-            f"{metrics['max_error']:.3g} m) exceeds planner.tolerance = {p.tolerance} m; the "
-            "path may be out of reach or blocked",
-            "trajectory",
-        )
-    turned = metrics.get("rms_orientation_error")
-    if turned is not None and turned > p.orientation_tolerance:
-        raise InfeasibleError(
-            f"not tracked: rms orientation error {turned:.3g} rad after {after} (max "
-            f"{metrics['max_orientation_error']:.3g} rad) exceeds planner.orientation_tolerance "
-            f"= {p.orientation_tolerance} rad",
-            "trajectory",
-        )
+    metrics |= stall_metrics(run, plan.scene, p.tolerance, p.d_min)
+    why = _not_tracked(metrics, p, lead, len(run.t))
+    metrics["tracked"] = why is None
+    details = {"limits": _limits(plan.scene)} | ({} if why is None else {"not_tracked": why})
     trace = trace_columns(run)
     if arm is not None:
         metrics |= arm.metrics(run, plan.scene, p.settle or 0.0)
         trace |= arm.columns()
     if config.servo is None:
-        return Result(metrics, trace, details={"limits": _limits(plan.scene)})
+        return Result(metrics, trace, details=details)
     stream, servo = run_stream(run, plan.scene.robot, config.servo.rate)
-    return Result(
-        metrics | servo,
-        trace,
-        tables={SERVO: stream.columns()},
-        details={"limits": _limits(plan.scene)},
-    )
+    return Result(metrics | servo, trace, tables={SERVO: stream.columns()}, details=details)
+
+
+def _not_tracked(metrics: dict[str, Any], p: PlannerSpec, lead: float, periods: int) -> str | None:
+    """Why the run did not track (the error beyond planner.tolerance, or the orientation's
+    beyond planner.orientation_tolerance, and the cause measured), or None when it did."""
+    after = f"{p.settle} s into the path" if lead else f"{p.settle} s"
+    cause = not_tracked_cause(metrics, metrics["infeasible_steps"], periods)
+    if metrics["rms_error"] > p.tolerance:
+        return (
+            f"not tracked: rms error {metrics['rms_error']:.3g} m after {after} (max "
+            f"{metrics['max_error']:.3g} m) exceeds planner.tolerance = {p.tolerance} m: {cause}"
+        )
+    turned = metrics.get("rms_orientation_error")
+    if turned is not None and turned > p.orientation_tolerance:
+        return (
+            f"not tracked: rms orientation error {turned:.3g} rad after {after} (max "
+            f"{metrics['max_orientation_error']:.3g} rad) exceeds planner.orientation_tolerance "
+            f"= {p.orientation_tolerance} rad: {cause}"
+        )
+    return None
 
 
 def twin_arm(config: PlanConfig, scene: Scene, q0: np.ndarray) -> Any:

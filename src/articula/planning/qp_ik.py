@@ -14,6 +14,7 @@ from pydantic import model_validator
 from articula.numba_cache import jit
 from articula.planning.reference_velocity import RateParams
 from articula.planning.resolved_rate import ResolvedRate
+from articula.planning.slide import DAMPER_MARGIN
 from articula.planning.task import Target
 from articula.validation import NonNegative, field_error
 
@@ -30,8 +31,10 @@ class QpIkParams(RateParams):
         joint_weight: λ_q.
         slack_weight: λ_δ.
         damper_gain: ξ [m/s] (rad/s for joint limits).
-        safety: d_s [m]; with influence d_i, ḋ ≥ −ξ (d − d_s)/(d_i − d_s) for d < d_i.
-        self_safety: d_s for two links of the arm [m] (checked self-collision pairs): smaller,
+        safety: d_s [m]; with influence d_i, ḋ ≥ −ξ (d − d_s)/(d_i − d_s) for d < d_i; at
+            least d_min + DAMPER_MARGIN (planning/slide.py), above the step check's floor.
+        self_safety: d_s for two links of the arm [m] (checked self-collision pairs; at least
+            self_d_min + DAMPER_MARGIN): smaller,
             as some sit closer than `safety` by design.
         limit_influence: d_i of the same damper on the distance to each joint limit [rad].
         limit_safety: d_s of the joint-limit damper [rad].
@@ -118,8 +121,8 @@ class QpIk(ResolvedRate):
             rows.distance,
             rows.gradient,
             rows.self_pair,
-            max(p.safety, self.d_min),
-            max(p.self_safety, self.scene.self_d_min),
+            max(p.safety, self.d_min + DAMPER_MARGIN),
+            max(p.self_safety, self.scene.self_d_min + DAMPER_MARGIN),
             p.influence,
             p.damper_gain,
             p.limit_influence,
@@ -128,6 +131,14 @@ class QpIk(ResolvedRate):
             p.slack_weight,
         )
         solution, _, status, _ = daqp.solve(H, np.zeros(H.shape[0]), A, upper, lower, sense)
+        if status <= 0:
+            # Dampers that each can be met but not all at once (a start inside their safety
+            # distance, the box of an arm at rest too small to push out along every row):
+            # ask of each only that it does not approach, which rest meets.
+            dampers = slice(H.shape[0], H.shape[0] + A.shape[0] - J.shape[0])
+            upper[dampers] = np.maximum(upper[dampers], 0.0)
+            relaxed = True
+            solution, _, status, _ = daqp.solve(H, np.zeros(H.shape[0]), A, upper, lower, sense)
         self.iterations += 1
         if status <= 0:
             return self._finish(q, q, box, rows, t, strained=True)  # brake: nearest to rest

@@ -11,12 +11,18 @@ import numpy as np
 
 from articula.planning.clearance import ClearanceRows, RowSource
 from articula.planning.planner import WARM_UP_STEPS
-from articula.planning.rate_limits import RateLimits, braking_after
+from articula.planning.rate_limits import RateLimits, braking_path
 from articula.planning.reference_velocity import task_rows
+from articula.planning.slide import SLIDE_BAND, SLIDE_MARGIN, slide_correction
 from articula.planning.task import Target, Task, as_target
+from articula.robots.sweep import joint_sweep
 from articula.scene.scene import Scene
 
 BACKTRACKS = 3  # halvings of a step that breaks a clearance before the arm brakes instead
+SLIDES = 3  # corrections of a step back onto the feasible side before it is halved
+# The (link-obstacle, self) clearance lost per metre a point of the arm moves at most: a link
+# pair's distance shrinks by both links' motions.
+PAIR_SWEEP = np.array([1.0, 2.0])
 
 
 @dataclass
@@ -50,9 +56,12 @@ class ResolvedRate(ABC):
     _previous: Target | None = field(default=None, init=False, repr=False)
     _rows: RowSource = field(init=False, repr=False)
     _limits: RateLimits = field(init=False, repr=False)
+    _task_jacobian: np.ndarray = field(init=False, repr=False)  # this period's task rows
+    _sweep: np.ndarray = field(init=False, repr=False)  # robots.sweep.joint_sweep [m/rad]
 
     def __post_init__(self) -> None:
         self._rows = RowSource(self.scene, self.use_compiled)
+        self._sweep = joint_sweep(self.scene.robot)
         if self.rate is None:
             speeds = self.scene.robot.velocity_limit
             self._limits = RateLimits(
@@ -116,6 +125,7 @@ class ResolvedRate(ABC):
             ee.x, ee.R, ee.J, self.task, target, self._previous, self.dt, self.params.gain
         )
         self._previous = target
+        self._task_jacobian = J
         return box, rows, J, v
 
     def _box(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -133,11 +143,12 @@ class ResolvedRate(ABC):
         strained: bool = False,
     ) -> np.ndarray:
         """The period's configuration: q_new within the box, kept if its clearances hold (or
-        grow), else halved toward braking, else braking (counted as infeasible); the motion
-        remembered for the acceleration limit."""
+        grow), else slid back onto the feasible side of the boundary it crossed (its motion
+        along that boundary kept), else halved toward braking, else braking (counted as
+        infeasible); the motion remembered for the acceleration limit."""
         q_new = np.clip(q_new, *box)
         if rows.distance.size:  # something is within the influence distance: check the step
-            q_new, held = self._clear_step(q, q_new, np.clip(q, *box), t)
+            q_new, held = self._clear_step(q, q_new, box, t)
             strained = strained or not held
         if strained or self._limits.strained:
             self.infeasible += 1
@@ -145,17 +156,16 @@ class ResolvedRate(ABC):
         return q_new
 
     def _clear_step(
-        self, q: np.ndarray, q_new: np.ndarray, brake: np.ndarray, t: float
+        self, q: np.ndarray, q_new: np.ndarray, box: tuple[np.ndarray, np.ndarray], t: float
     ) -> tuple[np.ndarray, bool]:
-        """(the first of q_new, its halvings toward `brake`, `brake` itself whose clearances,
-        there and where braking from it ends, are above d_min and self_d_min or no lower than
-        at q; whether one was)."""
+        """(q_new, or q_new slid onto the feasible side of the floors it crosses (up to SLIDES
+        corrections, planning/slide.py), or the first of its halvings toward braking, or braking
+        itself, whose clearances, there and where braking from it ends, are above d_min and
+        self_d_min or no lower than at q; whether one was)."""
         floors = np.array([self.d_min, self.scene.self_d_min])
         now = None
         candidate = q_new
-        for k in range(BACKTRACKS + 2):
-            if k == BACKTRACKS + 1:
-                candidate = brake
+        for k in range(SLIDES + 1):
             clear = self._clearances_braking(q, candidate, t)
             if np.all(clear > floors):
                 return candidate, True
@@ -163,21 +173,72 @@ class ResolvedRate(ABC):
                 now = self._clearances(q, t)
             if np.all((clear > floors) | (clear >= now)):
                 return candidate, True
-            candidate = brake + 0.5 * (candidate - brake)
-        return brake, False
+            correction = None if k == SLIDES else self._slide(q, candidate, box, t)
+            if correction is None:
+                break
+            candidate = candidate + correction
+        brake = np.clip(q, *box)
+        for k in range(1, BACKTRACKS + 1):
+            candidate = brake + 0.5**k * (q_new - brake)
+            clear = self._clearances_braking(q, candidate, t)
+            if np.all((clear > floors) | (clear >= now)):
+                return candidate, True
+        clear = self._clearances_braking(q, brake, t)
+        return brake, bool(np.all((clear > floors) | (clear >= now)))
+
+    def _slide(
+        self, q: np.ndarray, q_new: np.ndarray, box: tuple[np.ndarray, np.ndarray], t: float
+    ) -> np.ndarray | None:
+        """The correction [rad] that puts q_new, and where braking from it ends, back above
+        the floors to first order within the box (slide_correction); None when none does."""
+        floors = (self.d_min, self.scene.self_d_min)
+        reach = max(floors) + SLIDE_MARGIN + SLIDE_BAND
+        _, rows = self._rows(q_new, t, reach)
+        points = self._braking_points(q, q_new)
+        if len(points):  # where braking ends
+            _, at_end = self._rows(points[-1], t, reach)
+            rows = ClearanceRows(
+                np.concatenate([rows.distance, at_end.distance]),
+                np.vstack([rows.gradient, at_end.gradient]),
+                np.concatenate([rows.self_pair, at_end.self_pair]),
+            )
+        low, high = box[0] - q_new, box[1] - q_new
+        correction = slide_correction(rows, floors, low, high, self._task_jacobian)
+        if correction is None or not np.any(correction):
+            return None
+        return correction
 
     def _clearances_braking(self, q: np.ndarray, q_new: np.ndarray, t: float) -> np.ndarray:
-        """(link-obstacle, self) clearance [m] at q_new and, with acceleration limits, at the
-        point where braking from the motion q → q_new ends: the smaller of the two."""
+        """(link-obstacle, self) clearance [m]: the smaller of q_new's and, with acceleration
+        limits, of the points braking from the motion q → q_new passes (_braking_points),
+        each measured where the room above the floors left since the last measured one could
+        be used up (a motion Δq moves no point farther than Σ sweep_j |Δq_j|, so no link
+        pair's distance more than twice that), as baornn_kernel.stoppable does."""
         clear = self._clearances(q_new, t)
-        change = self._limits.change
-        if change is not None:
-            limits = self._limits
-            last = np.zeros_like(q) if limits.last_motion is None else limits.last_motion
-            jerk = np.zeros(0) if limits.jerk_change is None else limits.jerk_change
-            end = q_new + braking_after(q_new - q, last, change, jerk)
-            clear = np.minimum(clear, self._clearances(end, t))
-        return clear
+        points = self._braking_points(q, q_new)
+        floors = np.array([self.d_min, self.scene.self_d_min])
+        lowest, before = clear, q_new
+        room = np.min((clear - floors) / PAIR_SWEEP)
+        for point in points:
+            room -= self._sweep @ np.abs(point - before)
+            before = point
+            if room <= 0.0:
+                measured = self._clearances(point, t)
+                lowest = np.minimum(lowest, measured)
+                room = np.min((measured - floors) / PAIR_SWEEP)
+        return lowest
+
+    def _braking_points(self, q: np.ndarray, q_new: np.ndarray) -> np.ndarray:
+        """Where each period of braking as hard as the limits allow from the motion q → q_new
+        ends (rate_limits.braking_path) [rad], shape (periods, nq); none without acceleration
+        limits. Every period, not only where it stops: the joints stop at different times, and
+        the clearance between can be lower than at either end."""
+        limits = self._limits
+        if limits.change is None:
+            return np.zeros((0, q.size))
+        last = np.zeros_like(q) if limits.last_motion is None else limits.last_motion
+        jerk = np.zeros(0) if limits.jerk_change is None else limits.jerk_change
+        return q_new + braking_path(q_new - q, last, limits.change, jerk)
 
     def _clearances(self, q: np.ndarray, t: float) -> np.ndarray:
         """(link-obstacle, self) clearance at q [m], compiled where the scene allows it."""

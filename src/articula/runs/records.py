@@ -233,10 +233,11 @@ def atomic_write(path: Path, data: bytes) -> None:
         os.close(dir_fd)
 
 
-def _json_number(value: float | None) -> float | None:
+def _json_number(value: float | str | bool | None) -> float | str | bool | None:
     """A metric as JSON allows it: non-finite values become null, as does None (a metric
-    that does not apply, such as the self clearance of an arm without checked pairs)."""
-    if value is None:
-        return None
+    that does not apply, such as the self clearance of an arm without checked pairs); a
+    name or a flag stays as it is."""
+    if value is None or isinstance(value, (str, bool)):
+        return value
     value = float(value)
     return value if math.isfinite(value) else None
