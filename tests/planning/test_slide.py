@@ -1,7 +1,8 @@
 """planning/slide.py: the correction that brings a step back above its floors is the least-task-
 motion point of the linearised feasible set (against scipy's SLSQP), keeps the tangential part
 of a step that crosses one boundary, and says when no correction in the box exists; with it a
-resolved-rate arm whose link reaches d_min slides along it where, without, it froze."""
+resolved-rate arm whose link reaches d_min slides along it where, without, it froze, and
+baornn-improved's sliding step (change 8) takes it past a pair held at self_d_min."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from scipy.optimize import minimize
 from articula.bench import suite
 from articula.bench.problems import D_MIN
 from articula.planning import resolved_rate
+from articula.planning.baornn_improved import ImprovedBaornn
 from articula.planning.clearance import ClearanceRows
 from articula.planning.slide import JOINT_WEIGHT, SLIDE_BAND, SLIDE_MARGIN, slide_correction
 
@@ -120,3 +122,23 @@ def test_without_the_slide_the_same_arm_freezes_at_d_min(grazing_problem, monkey
     assert row["failure"] == "tracking"
     assert row["min_clearance"] == pytest.approx(D_MIN, abs=1e-5)
     assert row["stalled_s"] > 1.0
+
+
+@pytest.fixture
+def held_at_self_d_min(tmp_path):
+    """Task of solve_problem for grazing problem 16 of seed 0 (iiwa14), where baornn-improved's
+    search alone holds links 5 and 7 at self_d_min, 4 mm RMS off the path."""
+    return {"robot": {"builtin": "iiwa14"}, "seed": 0, "index": 16, "class": "grazing",
+            "methods": ["baornn-improved"], "key": "test",
+            "folder": str(tmp_path / "p16")}  # fmt: skip
+
+
+def test_baornn_improved_slides_along_self_d_min_where_its_search_alone_is_held(
+    held_at_self_d_min, monkeypatch
+):
+    (row,) = suite.solve_problem(held_at_self_d_min)[1]
+    assert row["success"], row
+    monkeypatch.setattr(ImprovedBaornn, "_slide", lambda self, q, g, target, t: (q, g))
+    (alone,) = suite.solve_problem(held_at_self_d_min)[1]
+    assert alone["failure"] == "tracking" and alone["rms_error"] > 3e-3
+    assert row["colliding_steps"] == alone["colliding_steps"] == 0

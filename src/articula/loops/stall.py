@@ -28,8 +28,8 @@ def stall_metrics(
     stall_at [s], stall_error [m], the closest pair there (stall_pair, "link / obstacle" or
     "link / link"), its distance stall_clearance [m] and how far above its floor it was
     (stall_margin [m]), and stall_joint_limit, the joints at a position limit ("" for none);
-    and the pair closest to its floor at the run's end (end_pair, end_clearance [m],
-    end_margin [m]).
+    and, at the largest error (worst_at [s]), the pair closest to its floor (worst_pair,
+    worst_clearance [m], worst_margin [m]).
 
     Args:
         run: the tracking run.
@@ -48,11 +48,13 @@ def stall_metrics(
         "stalled_s": float(np.sum(stalled)) * dt,
         "off_path_s": float(np.sum(off)) * dt,
     }
-    pair, distance, floor = closest_pair(scene, run.q[-1], float(run.t[-1]), d_min)
+    worst = int(np.argmax(run.error))
+    pair, distance, floor = closest_pair(scene, run.q[worst], float(run.t[worst]), d_min)
     out |= {
-        "end_pair": pair,
-        "end_clearance": distance,
-        "end_margin": None if distance is None else distance - floor,
+        "worst_at": float(run.t[worst]),
+        "worst_pair": pair,
+        "worst_clearance": distance,
+        "worst_margin": None if distance is None else distance - floor,
     }
     keys = ("stall_at", "stall_error", "stall_pair", "stall_clearance", "stall_margin")
     out |= dict.fromkeys(keys) | {"stall_joint_limit": None}
@@ -132,7 +134,8 @@ def not_tracked_cause(metrics: dict[str, Any], infeasible: float, periods: int) 
     """The measured reason a run did not track, in words: an error that stayed under a
     millimetre (a tolerance tighter than the method tracks), a stall at a clearance boundary
     or a joint limit (naming the pair or joint and the distance), a start no step could leave,
-    or an arm that moved but stayed off the path (naming the pair it ended nearest).
+    or an arm that moved but stayed off the path (naming the pair nearest its floor at the
+    largest error).
 
     Args:
         metrics: the run's tracking and stall metrics (stall_metrics).
@@ -149,12 +152,13 @@ def not_tracked_cause(metrics: dict[str, Any], infeasible: float, periods: int) 
             "tighter than the method tracks"
         )
     if stalled <= STALL_SHARE * (metrics.get("off_path_s") or 0.0):
-        ended = metrics.get("end_pair")
+        worst = metrics.get("worst_pair")
         near = (
             ""
-            if ended is None
-            else f"; it ended with {ended} at {1e3 * metrics['end_clearance']:.2f} mm "
-            f"({1e3 * metrics['end_margin']:.2f} mm above its floor)"
+            if worst is None
+            else f"; at the largest error, t = {metrics['worst_at']:.2f} s, {worst} was "
+            f"{1e3 * metrics['worst_clearance']:.2f} mm apart ({1e3 * metrics['worst_margin']:.2f}"
+            " mm above its floor)"
         )
         return (
             f"the arm moved but stayed off the path (max {1e3 * metrics['max_error']:.1f} mm, "

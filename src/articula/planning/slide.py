@@ -30,11 +30,15 @@ def slide_correction(
     low: np.ndarray,
     high: np.ndarray,
     task_jacobian: np.ndarray,
+    residual: np.ndarray | None = None,
+    weight: float = JOINT_WEIGHT,
+    band: float = SLIDE_BAND,
 ) -> np.ndarray | None:
     """The joint correction Δ [rad] with ∇d_i·Δ ≥ floor_i + SLIDE_MARGIN − d_i for every row
-    within SLIDE_BAND of that target, and low ≤ Δ ≤ high, that moves the task least
-    (|JΔ|² + JOINT_WEIGHT |Δ|²): the step's projection back onto the feasible side, to first
-    order, keeping its motion along the boundary and, where the redundancy allows, the task.
+    within `band` of that target, and low ≤ Δ ≤ high, that fits the task best,
+    |JΔ − r|² + weight·|Δ|²: with r = 0 the step's projection back onto the feasible side, to
+    first order, that moves the task least, keeping its motion along the boundary; with r the
+    task's residual, a Gauss-Newton step toward the path that slides along the boundary.
 
     Args:
         rows: the clearance rows at the step's end (distances [m], gradients [m/rad], which
@@ -44,15 +48,18 @@ def slide_correction(
             shape (nq,) [rad].
         high: the highest, shape (nq,) [rad].
         task_jacobian: J of the task's rows, shape (m, nq) [m/rad, or weighted rad/rad].
+        residual: r, the task motion wanted, shape (m,) [m]; None: none (zeros).
+        weight: the cost of 1 rad of correction against 1 m of task misfit [m²/rad²].
+        band: rows within this much of their target count [m].
 
     Returns:
-        The correction, shape (nq,) [rad]; zeros when no row is near its floor; None when no
-        correction within [low, high] meets the rows (to first order).
+        The correction, shape (nq,) [rad]; zeros when no row is near its floor and r is None;
+        None when no correction within [low, high] meets the rows (to first order).
     """
     n = low.size
     floor = np.where(rows.self_pair, floors[1], floors[0]) + SLIDE_MARGIN
-    near = rows.distance < floor + SLIDE_BAND
-    if not np.any(near):
+    near = rows.distance < floor + band
+    if not np.any(near) and residual is None:
         return np.zeros(n)
     A = np.ascontiguousarray(rows.gradient[near])
     if np.any(np.all(A == 0.0, axis=1) & (rows.distance[near] < floor[near])):
@@ -60,10 +67,9 @@ def slide_correction(
     need = floor[near] - rows.distance[near]
     upper = np.concatenate([high, np.full(need.size, 1e30)])
     lower = np.concatenate([low, need])
-    H = task_jacobian.T @ task_jacobian + JOINT_WEIGHT * np.eye(n)
-    solution, _, status, _ = daqp.solve(
-        H, np.zeros(n), A, upper, lower, np.zeros(upper.size, dtype=np.intc)
-    )
+    H = task_jacobian.T @ task_jacobian + weight * np.eye(n)
+    f = np.zeros(n) if residual is None else -task_jacobian.T @ residual
+    solution, _, status, _ = daqp.solve(H, f, A, upper, lower, np.zeros(upper.size, dtype=np.intc))
     if status <= 0:
         return None
     return np.clip(solution, low, high)

@@ -67,10 +67,11 @@ def test_a_path_just_within_reach_is_not_refused_by_the_reach_check(monkeypatch)
         run_plan(_config(_data()))
 
 
-def test_an_untracked_path_is_refused_naming_the_tolerance():
-    with pytest.raises(InfeasibleError) as err:
-        run_plan(_config(_data(tolerance=1e-9)))
-    assert "tolerance" in str(err.value) and err.value.field == "trajectory"
+def test_an_untracked_path_is_marked_naming_the_tolerance_and_the_cause():
+    result = run_plan(_config(_data(tolerance=1e-9)))
+    assert result.metrics["tracked"] is False
+    why = result.details["not_tracked"]
+    assert "planner.tolerance = 1e-09" in why and "tighter than the method tracks" in why
 
 
 def test_a_start_inside_d_min_is_refused_naming_robot_q0():
