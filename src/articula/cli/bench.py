@@ -24,6 +24,12 @@ bench_app = typer.Typer(no_args_is_help=True, help="Benchmarks of articula besid
 app.add_typer(bench_app, name="bench")
 
 
+CLASS_HELP = (
+    "standard; tight: obstacles 2-5 cm from the links; grazing: the links' obstacle-free "
+    "motion passes within d_min of them."
+)
+
+
 @bench_app.command()
 def suite(
     out_dir: OutDir,
@@ -36,14 +42,7 @@ def suite(
     ] = "iiwa14",
     problems: Annotated[int, typer.Option(min=1, max=10_000, help="Generated problems.")] = 100,
     seed: Annotated[int, typer.Option(min=0, help="Seed of the problems.")] = 0,
-    problem_class: Annotated[
-        str,
-        typer.Option(
-            "--class",
-            help="standard; tight: obstacles 2-5 cm from the links; grazing: the links' "
-            "obstacle-free motion passes within d_min of them.",
-        ),
-    ] = "standard",
+    problem_class: Annotated[str, typer.Option("--class", help=CLASS_HELP)] = "standard",
     methods: Annotated[
         str | None,
         typer.Option(

@@ -8,5 +8,6 @@ __all__ = [
     "pneunet_pid",
     "servo",
     "six_chamber",
+    "stall",
     "tracking",
 ]

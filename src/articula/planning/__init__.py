@@ -18,6 +18,7 @@ __all__ = [
     "reach",
     "reference_velocity",
     "resolved_rate",
+    "slide",
     "target_path",
     "task",
     "trajectories",
