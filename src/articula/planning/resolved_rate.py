@@ -160,8 +160,8 @@ class ResolvedRate(ABC):
     ) -> tuple[np.ndarray, bool]:
         """(q_new, or q_new slid onto the feasible side of the floors it crosses (up to SLIDES
         corrections, planning/slide.py), or the first of its halvings toward braking, or braking
-        itself, whose clearances, there and where braking from it ends, are above d_min and
-        self_d_min or no lower than at q; whether one was)."""
+        itself, whose clearances, there and along braking from it (_clearances_braking), are
+        above d_min and self_d_min or no lower than at q; whether one was)."""
         floors = np.array([self.d_min, self.scene.self_d_min])
         now = None
         candidate = q_new
