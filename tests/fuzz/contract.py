@@ -142,6 +142,11 @@ def violations(example: Example, outcome: Outcome, before: Mapping[str, str]) ->
             problems.append(f"refusal with {len(lines)} stderr lines, expected one")
         if not lines or not lines[0].startswith("error:") or not lines[0][6:].strip():
             problems.append("refusal whose stderr does not start with a non-empty `error:` line")
+    if outcome.status == 2 and _not_tracked(example.out):
+        # A run that did not track its path is a result, written and marked (issue 42).
+        if "is written" not in outcome.stderr:
+            problems.append("a not-tracked run whose error line does not name its folder")
+    elif outcome.status == 2:
         if outcome.wall > REFUSE_SECONDS:
             problems.append(f"refusal after {outcome.wall:.1f} s (limit {REFUSE_SECONDS:g} s)")
         if example.out is not None and _exists(example.out):
@@ -152,6 +157,15 @@ def violations(example: Example, outcome: Outcome, before: Mapping[str, str]) ->
     if outcome.status == 0 and example.as_json:
         problems.extend(_json_problems(example, outcome))
     return problems
+
+
+def _not_tracked(out: Path | None) -> bool:
+    """Whether `out` holds a complete run folder whose record says it did not track."""
+    try:
+        record = json.loads((out / "record.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError, TypeError):
+        return False
+    return isinstance(record, dict) and "not_tracked" in record and record.get("complete", True)
 
 
 def _exists(path: Path) -> bool:

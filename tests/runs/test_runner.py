@@ -153,14 +153,33 @@ def test_an_infeasible_point_is_recorded_and_the_sweep_goes_on(tmp_path):
                        "times": [0.0, 1.0]},
         "planner": {"method": "qp", "duration": 0.2, "settle": 0.1},
     }  # fmt: skip
-    configs = sweep.expand_sweep({"base": plan, "grid": {"planner.tolerance": [10.0, 1e-9]}})
+    far = [[3.0, 0.0, 0.5], [3.0, 0.0, 0.6]]  # beyond the arm's reach: refused before planning
+    grid = {"trajectory.points": [plan["trajectory"]["points"], far]}
+    configs = sweep.expand_sweep({"base": plan, "grid": grid})
     table = runner.run_sweep(configs, tmp_path / "out")
     errors = table.column("error").to_pylist()
-    assert errors[0] is None and "tolerance" in errors[1]
+    assert errors[0] is None and "reach" in errors[1]
     assert table.column("rms_error").to_pylist()[1] is None
     failed = tmp_path / "out" / records.config_hash(configs[1])
     assert records.is_finished(failed)  # the same config fails the same way: not retried
     assert records.read_record(failed)["error"] == errors[1]
+
+
+def test_a_point_that_does_not_track_is_a_result_marked_not_tracked(tmp_path):
+    plan = {
+        "experiment": "baornn.plan",
+        "robot": {"builtin": "iiwa14"},
+        "trajectory": {"type": "waypoints", "points": [[0, 0.6, 0.5], [0, 0.6, 0.6]],
+                       "times": [0.0, 1.0]},
+        "planner": {"method": "qp", "duration": 0.2, "settle": 0.1},
+    }  # fmt: skip
+    configs = sweep.expand_sweep({"base": plan, "grid": {"planner.tolerance": [10.0, 1e-9]}})
+    table = runner.run_sweep(configs, tmp_path / "out")
+    assert table.column("error").to_pylist() == [None, None]
+    assert table.column("tracked").to_pylist() == [True, False]
+    assert None not in table.column("rms_error").to_pylist()  # measured either way
+    record = records.read_record(tmp_path / "out" / records.config_hash(configs[1]))
+    assert "planner.tolerance = 1e-09" in record["not_tracked"]
 
 
 def test_results_spread_short_lists_into_columns():

@@ -73,7 +73,9 @@ def test_a_pose_task_off_its_orientation_is_not_tracked():
                            "times": [0.0, 1.0], "rpy": [1.0, 0.0, 0.0]},
             "planner": {"method": "baornn-improved", "task": "pose", "orientation_weight": 0.0,
                         "duration": 2.0, "settle": 1.0}}  # fmt: skip
-    with pytest.raises(InfeasibleError, match=r"planner\.orientation_tolerance"):
-        run_plan(parse_model(PlanConfig, data))
+    result = run_plan(parse_model(PlanConfig, data))
+    assert result.metrics["tracked"] is False
+    assert "planner.orientation_tolerance" in result.details["not_tracked"]
     data["planner"]["orientation_tolerance"] = 3.0
-    run_plan(parse_model(PlanConfig, data))  # within the tolerance it is given
+    result = run_plan(parse_model(PlanConfig, data))  # within the tolerance it is given
+    assert result.metrics["tracked"] is True
