@@ -31,8 +31,8 @@
    does not see) tries one more candidate, the Gauss-Newton step on the task constrained to
    keep every such pair above its floor to first order (planning/slide.py). The antennae see
    the boundary only as points outside Ω; this step moves along it, the way the redundancy
-   allows (issue 42: held at self_d_min, the search alone left 10 of 100 grazing problems
-   off the path).
+   allows (issue 42, 100 grazing problems: 90 → 91 % on the iiwa14, 91 → 96 % on the
+   Panda).
 """
 
 from __future__ import annotations
