@@ -31,7 +31,8 @@ BASELINE = {"dt": 0.02, "d_min": 0.003, "gain": 12.0, "influence": 0.2, "safety"
 )
 def test_make_planner_builds_a_beetle_search_on_the_spec_objective(method, kind):
     improved = {"pairs": 5, "short_antenna": 0.5, "yield_distance": 0.04, "newton_damping": 0.01,
-                "quiet_error": 2e-5, "flat_penalty_slope": 0.2}  # fmt: skip
+                "quiet_error": 2e-5, "flat_penalty_slope": 0.2,
+                "slide_reach": 0.02}  # fmt: skip
     spec = PlannerSpec(method=method, **improved, **BEETLE)
     planner = make_planner(spec, SCENE, seed=0)
     assert type(planner) is kind

@@ -139,6 +139,8 @@ class PlannerSpec(StrictModel):
             the penalty is flat; 0: never early [m].
         flat_penalty_slope: the penalty slope Λβ/d^(β+1) below which baornn-improved tries
             the Gauss-Newton step and may stop early; 0: never [-].
+        slide_reach: how near its floor (d_min, self_d_min) a pair brings baornn-improved's
+            sliding step into play; 0: never [m].
         gain: K on the task error, baselines [1/s].
         damping: μ of damped least squares, dls [m].
         repulsion: η of the obstacle repulsion, pinv and dls [m²/s].
@@ -185,6 +187,7 @@ class PlannerSpec(StrictModel):
     newton_damping: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.02
     quiet_error: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 1e-5
     flat_penalty_slope: Annotated[float, Field(ge=0)] = 0.1
+    slide_reach: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.01
     gain: NonNegative = 20.0
     damping: NonNegative = 0.02
     repulsion: NonNegative = 0.02
