@@ -1,6 +1,6 @@
 """Success rates of articula's arm controllers beside mink's on generated problems (issue 13).
 
-    python benchmarks/suite.py [--json] [--problems N] [--out DIR] [--problem-class tight]
+    python benchmarks/suite.py [--json] [--problems N] [--out DIR] [--problem-class CLASS]
                                                                      (needs '.[peers]')
 
 Runs `articula bench suite` (articula/bench/suite.py) with seed 0 for two arms: the built-in
@@ -11,7 +11,7 @@ qp's dampers). Keys: <arm>_<method>_success (arm iiwa14 | panda, method with "-"
 <arm>_<method>_step_us (median), <arm>_<method>_mean_step_us, <arm>_<method>_vs_best_mink,
 <arm>_<method>_step_time_vs_mink (mean step time over mink's); the folders stay under --out
 (default: a temporary folder) with every problem as a scene file. --problem-class tight:
-obstacles 2-5 cm from where the links pass (bench/problems.py).
+obstacles 2-5 cm from where the links pass; grazing: within d_min of it (bench/problems.py).
 """
 
 from __future__ import annotations
