@@ -76,16 +76,25 @@ def test_a_problem_file_runs_with_articula_plan(generated, tmp_path, cli, one_js
     assert metrics["min_clearance"] > 0 and metrics["max_speed_ratio"] <= 1.0 + 1e-9
 
 
-def test_tight_obstacles_sit_2_to_5_cm_from_the_obstacle_free_motion(tmp_path):
+@pytest.mark.parametrize(
+    ("problem_class", "count", "gap"),
+    [("tight", (2, 4), problems.TIGHT_GAP), ("grazing", (1, 2), problems.GRAZING_GAP)],
+)
+def test_each_obstacle_sits_its_class_gap_from_the_obstacle_free_motion(
+    tmp_path, problem_class, count, gap
+):
+    # tight: 2-5 cm from the links; grazing: the links pass within d_min of it (or into it).
     for index in range(3):
-        problem = problems.generate(IIWA, 3, index, "tight")
+        problem = problems.generate(IIWA, 3, index, problem_class)
         scene, q0, targets = _scene(problem, tmp_path)
         duration = problem.config["planner"]["duration"]
         # The obstacle-free motion again: damped least squares along the path.
         planner = VelocityIk(Scene(scene.robot, []), "dls", problems.DT)
         motion = track(planner, targets, q0, problems.DT, duration, 10**6).q
-        assert 2 <= len(scene.obstacles) <= 4
+        assert count[0] <= len(scene.obstacles) <= count[1]
         for obstacle in scene.obstacles:
             alone = Scene(scene.robot, [obstacle])
             closest = min(alone.clearances(q)[0] for q in motion)
-            assert problems.TIGHT_GAP[0] - 1e-9 <= closest <= problems.TIGHT_GAP[1] + 1e-9
+            assert gap[0] - 1e-9 <= closest <= gap[1] + 1e-9
+            if problem_class == "grazing":
+                assert closest <= problems.D_MIN  # the free motion breaks d_min
