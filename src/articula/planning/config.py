@@ -132,15 +132,13 @@ class PlannerSpec(StrictModel):
         pairs: antenna pairs per iteration, baornn-improved.
         short_antenna: relative length of every second antenna pair, baornn-improved.
         yield_distance: clearance below which baornn-improved may leave the path to keep
-            clear; above it the penalty moves the arm through the redundancy only; inf: the
-            book's acceptance [m].
+            clear (above it the penalty uses the redundancy only; inf: the book's) [m].
         newton_damping: μ of baornn-improved's Gauss-Newton candidate; 0: none [m].
         quiet_error: task error below which a baornn-improved period stops iterating where
             the penalty is flat; 0: never early [m].
         flat_penalty_slope: the penalty slope Λβ/d^(β+1) below which baornn-improved tries
             the Gauss-Newton step and may stop early; 0: never [-].
-        slide_reach: how near its floor (d_min, self_d_min) a pair brings baornn-improved's
-            sliding step into play; 0: never [m].
+        slide_reach: nearness to d_min or self_d_min where baornn-improved slides; 0: never [m].
         gain: K on the task error, baselines [1/s].
         damping: μ of damped least squares, dls [m].
         repulsion: η of the obstacle repulsion, pinv and dls [m²/s].
@@ -201,8 +199,7 @@ class PlannerSpec(StrictModel):
     approach: Literal["auto", "none"] = "auto"
     approach_speed: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)] = 0.25
     approach_turn_rate: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)] = 0.5
-    # What the end effector tracks (beyond the book's position): the trajectory's orientation
-    # or tool axis; without one given, the start's is held.
+    # What the end effector tracks beyond the book's position (none given: the start's held).
     task: TaskKind = "position"
     orientation_weight: NonNegative = 0.1
     tool_axis: Point = Field(default_factory=lambda: [0.0, 0.0, 1.0])
