@@ -145,14 +145,19 @@ def test_execute_names_the_file_of_a_bad_config():
     assert err.value.field == "bad.toml: duration"
 
 
-def test_an_infeasible_point_is_recorded_and_the_sweep_goes_on(tmp_path):
-    plan = {
+def _short_qp_plan() -> dict:
+    """A 0.2 s baornn.plan of the qp along a 10 cm segment in front of the iiwa14."""
+    return {
         "experiment": "baornn.plan",
         "robot": {"builtin": "iiwa14"},
         "trajectory": {"type": "waypoints", "points": [[0, 0.6, 0.5], [0, 0.6, 0.6]],
                        "times": [0.0, 1.0]},
         "planner": {"method": "qp", "duration": 0.2, "settle": 0.1},
     }  # fmt: skip
+
+
+def test_an_infeasible_point_is_recorded_and_the_sweep_goes_on(tmp_path):
+    plan = _short_qp_plan()
     far = [[3.0, 0.0, 0.5], [3.0, 0.0, 0.6]]  # beyond the arm's reach: refused before planning
     grid = {"trajectory.points": [plan["trajectory"]["points"], far]}
     configs = sweep.expand_sweep({"base": plan, "grid": grid})
@@ -166,13 +171,7 @@ def test_an_infeasible_point_is_recorded_and_the_sweep_goes_on(tmp_path):
 
 
 def test_a_point_that_does_not_track_is_a_result_marked_not_tracked(tmp_path):
-    plan = {
-        "experiment": "baornn.plan",
-        "robot": {"builtin": "iiwa14"},
-        "trajectory": {"type": "waypoints", "points": [[0, 0.6, 0.5], [0, 0.6, 0.6]],
-                       "times": [0.0, 1.0]},
-        "planner": {"method": "qp", "duration": 0.2, "settle": 0.1},
-    }  # fmt: skip
+    plan = _short_qp_plan()
     configs = sweep.expand_sweep({"base": plan, "grid": {"planner.tolerance": [10.0, 1e-9]}})
     table = runner.run_sweep(configs, tmp_path / "out")
     assert table.column("error").to_pylist() == [None, None]

@@ -100,7 +100,7 @@ class ImprovedBaornn(BeetleSearch):
     _rows: RowSource = field(init=False, repr=False)  # clearance rows for change 8
 
     def __post_init__(self) -> None:
-        self._rows = RowSource(self.objective.scene, self.objective.compiled is not None)
+        self._rows = RowSource(self.objective.scene, evaluation=self.objective.evaluation)
 
     def iterate(
         self, q: np.ndarray, g: float, target: Target | np.ndarray, t: float

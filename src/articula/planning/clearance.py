@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from articula.planning.evaluation import evaluation_for
+from articula.planning.evaluation import CompiledEvaluation, SceneEvaluation, evaluation_for
 from articula.scene import compiled_rows
 from articula.scene.scene import Scene
 
@@ -52,6 +52,7 @@ class RowSource:
     Args:
         scene: the robot, its obstacles and its checked link pairs.
         use_compiled: try the compiled evaluation (False: always Pinocchio and coal).
+        evaluation: an evaluation of `scene` to share (an objective's); None: one of its own.
 
     Attributes:
         scene: the scene.
@@ -59,9 +60,14 @@ class RowSource:
         compiled: the evaluation's compiled arrays, or None.
     """
 
-    def __init__(self, scene: Scene, use_compiled: bool = True) -> None:
+    def __init__(
+        self,
+        scene: Scene,
+        use_compiled: bool = True,
+        evaluation: CompiledEvaluation | SceneEvaluation | None = None,
+    ) -> None:
         self.scene = scene
-        self.evaluation = evaluation_for(scene, use_compiled)
+        self.evaluation = evaluation or evaluation_for(scene, use_compiled)
         self.compiled = self.evaluation.compiled
 
     def __call__(

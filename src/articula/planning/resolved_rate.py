@@ -162,7 +162,7 @@ class ResolvedRate(ABC):
         corrections, planning/slide.py), or the first of its halvings toward braking, or braking
         itself, whose clearances, there and along braking from it (_clearances_braking), are
         above d_min and self_d_min or no lower than at q; whether one was)."""
-        floors = np.array([self.d_min, self.scene.self_d_min])
+        floors = self._floors
         now = None
         candidate = q_new
         for k in range(SLIDES + 1):
@@ -191,7 +191,7 @@ class ResolvedRate(ABC):
     ) -> np.ndarray | None:
         """The correction [rad] that puts q_new, and where braking from it ends, back above
         the floors to first order within the box (slide_correction); None when none does."""
-        floors = (self.d_min, self.scene.self_d_min)
+        floors = self._floors
         reach = max(floors) + SLIDE_MARGIN + SLIDE_BAND
         _, rows = self._rows(q_new, t, reach)
         points = self._braking_points(q, q_new)
@@ -216,7 +216,7 @@ class ResolvedRate(ABC):
         pair's distance more than twice that), as baornn_kernel.stoppable does."""
         clear = self._clearances(q_new, t)
         points = self._braking_points(q, q_new)
-        floors = np.array([self.d_min, self.scene.self_d_min])
+        floors = self._floors
         lowest, before = clear, q_new
         room = np.min((clear - floors) / PAIR_SWEEP)
         for point in points:
@@ -239,6 +239,11 @@ class ResolvedRate(ABC):
         last = np.zeros_like(q) if limits.last_motion is None else limits.last_motion
         jerk = np.zeros(0) if limits.jerk_change is None else limits.jerk_change
         return q_new + braking_path(q_new - q, last, limits.change, jerk)
+
+    @property
+    def _floors(self) -> np.ndarray:
+        """(d_min, self_d_min): the floors of link-obstacle and link-link clearance [m]."""
+        return np.array([self.d_min, self.scene.self_d_min])
 
     def _clearances(self, q: np.ndarray, t: float) -> np.ndarray:
         """(link-obstacle, self) clearance at q [m], compiled where the scene allows it."""

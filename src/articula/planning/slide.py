@@ -26,7 +26,7 @@ SLIDE_BAND = 1e-3
 
 def slide_correction(
     rows: ClearanceRows,
-    floors: tuple[float, float],
+    floors: tuple[float, float] | np.ndarray,
     low: np.ndarray,
     high: np.ndarray,
     task_jacobian: np.ndarray,
