@@ -64,11 +64,21 @@ def test_a_stop_at_any_phase_leaves_every_output_off_by_its_ack(traced, name, co
     assert active_now(rig, trace) == []  # at rest from start-up
     rng = np.random.default_rng(27)
     trials = [stop_trial(rig, trace, link, rng) for _ in range(count)]
+    # Coverage, not the property: the STOP's moment is drawn in host wall time, and on a loaded
+    # machine the emulated board runs slower than that draw assumes, so the STOPs can bunch in
+    # part of the period (six_chamber: 0.45-0.90 once in CI). More trials until they spread.
+    while _spread(trials) <= 0.5 and len(trials) < 3 * count:
+        trials.append(stop_trial(rig, trace, link, rng))
     assert [t for t in trials if t.failed] == []
     # Stronger than "within a period of the ACK": the outputs are off before it goes out.
     assert max(t.ack_to_safe_s for t in trials) < 0
-    phases = sorted(t.phase for t in trials)  # the STOPs came all over the period
-    assert phases[-1] - phases[0] > 0.5
+    assert _spread(trials) > 0.5  # the STOPs came all over the period
+
+
+def _spread(trials: list) -> float:
+    """The span of the trials' STOP phases, as a fraction of the period."""
+    phases = [t.phase for t in trials]
+    return max(phases) - min(phases)
 
 
 @pytest.mark.parametrize("name", RIGS)
