@@ -15,47 +15,10 @@ from articula.experiments.plan import PlanConfig, load_plan, run_plan
 from articula.runs.registry import Result
 from articula.scene.config import build_scene
 from articula.validation import parse_model
+from tests.arms import CONFIGS, arm_scene, panda_robot
 
-CONFIGS = Path(__file__).resolve().parents[2] / "src/articula/book/ch1/configs"
 BOOK = ["circle_one_obstacle", "circle_two_obstacles", "rectangle_one_obstacle"]
 METHODS = ["baornn", "baornn-improved", "qp", "pinv", "dls"]
-PANDA_HOME = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785]  # [rad] libfranka's ready pose
-
-
-def _pybullet_data() -> Path:
-    data = pytest.importorskip("pybullet_data")
-    return Path(data.getDataPath())
-
-
-def panda_robot() -> dict:
-    """The Franka Panda of pybullet_data, its fingers locked, at libfranka's ready pose."""
-    folder = _pybullet_data() / "franka_panda"
-    return {"urdf": str(folder / "panda.urdf"), "package_dirs": [str(folder)],
-            "locked_joints": {"panda_finger_joint1": 0.02}, "q0": PANDA_HOME}  # fmt: skip
-
-
-def arm_scene(name: str) -> dict:
-    """A plan config of a Panda circling past a box, a ball and a mesh, or an xArm6 past a
-    ball and a box, with the [planner] defaults but for Λ, d_min and the run's length."""
-    planner = {"lambda_weight": 0.002, "d_min": 0.005, "duration": 12.0, "settle": 2.0}
-    circle = {"type": "circle", "axis_a": [0.0, 1.0, 0.0], "axis_b": [0.0, 0.0, 1.0],
-              "period": 10.0}  # fmt: skip
-    if name == "panda":
-        return {"robot": panda_robot(), "planner": planner,
-                "trajectory": {**circle, "center": [0.45, 0.0, 0.45], "radius": 0.15},
-                "obstacles": [
-                    {"name": "box", "box": [0.2, 0.1, 0.1], "position": [0.45, -0.28, 0.35]},
-                    {"name": "ball", "sphere": 0.05, "position": [0.3, 0.22, 0.62]},
-                    {"name": "rock", "mesh": str(CONFIGS / "rock.stl"), "scale": 0.5,
-                     "position": [0.62, 0.1, 0.2]}]}  # fmt: skip
-    folder = _pybullet_data() / "xarm"
-    return {"robot": {"urdf": str(folder / "xarm6_robot.urdf"), "package_dirs": [str(folder)],
-                      "q0": [0.0, -0.3, -0.6, 0.0, 0.9, 0.0]},
-            "planner": planner,
-            "trajectory": {**circle, "center": [0.4, 0.0, 0.3], "radius": 0.12},
-            "obstacles": [{"name": "ball", "sphere": 0.05, "position": [0.3, 0.25, 0.35]},
-                          {"name": "box", "box": [0.1, 0.1, 0.3],
-                           "position": [0.45, -0.25, 0.15]}]}  # fmt: skip
 
 
 def plan(data: dict, method: str) -> tuple[Result, PlanConfig]:

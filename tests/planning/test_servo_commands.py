@@ -17,7 +17,8 @@ from articula.experiments.plan import PlanConfig, load_plan, run_plan
 from articula.runs.registry import Result
 from articula.scene.config import build_scene
 from articula.validation import parse_model
-from tests.planning.test_safe_commands import BOOK, CONFIGS, METHODS, arm_scene
+from tests.arms import CONFIGS, arm_scene
+from tests.planning.test_safe_commands import BOOK, METHODS
 
 JERK = "velocity+acceleration+jerk"
 

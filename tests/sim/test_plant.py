@@ -17,7 +17,7 @@ import pytest
 from articula.experiments.plan import PlanConfig, load_plan, run_plan
 from articula.scene.config import build_scene
 from articula.validation import parse_model
-from tests.planning.test_safe_commands import CONFIGS, arm_scene
+from tests.arms import CONFIGS, arm_scene
 
 pytest.importorskip("mujoco", reason='the twin needs the `sim` extra: pip install -e ".[sim]"')
 
