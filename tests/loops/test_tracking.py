@@ -106,3 +106,30 @@ def test_trace_columns_name_each_series():
     np.testing.assert_array_equal(columns["q_1"], run.q[:, 0])
     np.testing.assert_array_equal(columns["y_ref"], run.x_ref[:, 1])
     np.testing.assert_array_equal(columns["clearance"], run.clearance)
+
+
+def test_acceleration_use_of_runs_written_out_by_hand():
+    # From rest at q0 = 0, joint 1 at constant acceleration 0.5 of its limit for 10 periods,
+    # then joint 2 bang-bang at its full limit for 10: second differences by hand.
+    dt, n = 0.01, 20
+    limit = ROBOT.acceleration_limit
+    k = np.arange(1, n + 1)
+    q = np.zeros((n, ROBOT.nq))
+    q[:10, 0] = 0.5 * limit[0] * 0.5 * (k[:10] * dt) ** 2 + 0.5 * 0.5 * limit[0] * k[:10] * dt**2
+    # 2nd difference of a·(k² + k)/2·dt² is a·dt²: a constant 0.5 of the limit.
+    q[10:, 0] = q[9, 0] + (q[9, 0] - q[8, 0]) * np.arange(1, 11)  # coasting: no acceleration
+    bang = np.cumsum(np.cumsum(np.where(np.arange(10) % 2 == 0, 1.0, -1.0))) * limit[1] * dt**2
+    q[10:, 1] = bang
+    t = np.arange(n) * dt
+    x = np.zeros((n, 3))
+    run = PlanResult(t, q, x, x, np.zeros(n), np.full(n, 1.0), planner_seconds=0.0, q0=np.zeros(7))
+    first = tracking_metrics(run, ROBOT, settle=0.0, iterations=1)
+    ratio = np.abs(np.diff(np.vstack([np.zeros((2, 7)), q]), 2, axis=0)) / (dt**2 * limit)
+    assert ratio[:10, 0] == pytest.approx(np.full(10, 0.5))  # the hand-made motion
+    assert first["accel_rms_ratio"] == pytest.approx(np.sqrt(np.mean(ratio**2)))
+    # Periods 10..19 have joint 2 at its full limit (and the start of the coast is no jump).
+    assert first["saturated_fraction"] == pytest.approx(np.mean(np.any(ratio >= 0.9, axis=1)))
+    assert 0.4 <= first["saturated_fraction"] <= 0.6
+    settled = tracking_metrics(run, ROBOT, settle=0.095, iterations=1)  # the last 10 periods
+    assert settled["saturated_fraction"] == 1.0
+    assert settled["accel_rms_ratio"] == pytest.approx(np.sqrt(np.mean(ratio[10:] ** 2)))

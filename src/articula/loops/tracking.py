@@ -149,6 +149,10 @@ def track(
     )
 
 
+# A joint at this share of its acceleration limit or more counts as saturated [-].
+SATURATED = 0.9
+
+
 def tracking_metrics(
     run: PlanResult, robot: RobotModel, settle: float, iterations: float, cone: float | None = None
 ) -> dict[str, float]:
@@ -159,9 +163,11 @@ def tracking_metrics(
     approach from q0 is the riskiest part), between the checked link pairs too
     (min_self_clearance, self_collisions; None without pairs); joint-limit violations; the
     largest joint speed, acceleration and jerk over their limits (max_speed_ratio,
-    max_acceleration_ratio, max_jerk_ratio); the periods that could not keep every constraint
-    (infeasible_steps); planner time per inner iteration (`iterations` in all) and per period
-    [µs], both without the first period, and that period's time (first_period_ms).
+    max_acceleration_ratio, max_jerk_ratio) and how hard the settled commands use the
+    acceleration limits (accel_rms_ratio, saturated_fraction: acceleration_use); the periods
+    that could not keep every constraint (infeasible_steps); planner time per inner iteration
+    (`iterations` in all) and per period [µs], both without the first period, and that
+    period's time (first_period_ms).
     For a pose or axis task also rms_ and max_orientation_error [rad] after `settle`, and with
     a `cone` [rad] the settled steps whose tool axis is outside it (cone_violations).
 
@@ -204,6 +210,7 @@ def tracking_metrics(
         "max_speed_ratio": max_speed_ratio(run, robot),
         "max_acceleration_ratio": max_acceleration_ratio(run, robot),
         "max_jerk_ratio": max_jerk_ratio(run, robot),
+        **acceleration_use(run, robot, settled),
         "infeasible_steps": float(run.infeasible),
         "approach_s": run.path_start,
         # The planner alone: BAORNN's inner iterations, or a baseline's periods; the first
@@ -262,6 +269,39 @@ def max_jerk_ratio(run: PlanResult, robot: RobotModel) -> float:
         The largest jerk ratio (above 1: a limit is broken); 0 for fewer than four samples.
     """
     return _max_rate_ratio(run, robot, 3, robot.jerk_limit)
+
+
+def acceleration_use(run: PlanResult, robot: RobotModel, settled: np.ndarray) -> dict[str, float]:
+    """How hard the commands use the acceleration limits once settled: accel_rms_ratio, the
+    RMS over the settled periods and joints of |q̈_i| / (acceleration limit of joint i), and
+    saturated_fraction, the share of settled periods with some joint at ≥ SATURATED of its
+    limit; q̈ by second differences of the periods from rest at q0 (as
+    max_acceleration_ratio), joints without a limit not counted.
+
+    Args:
+        run: the tracking run.
+        robot: the robot, for its joint acceleration limits.
+        settled: which periods count, shape (k,).
+
+    Returns:
+        accel_rms_ratio and saturated_fraction (0 for no settled period or no limit).
+    """
+    q = run.q if run.q0 is None else np.vstack([run.q0, run.q0, run.q])
+    limit = robot.acceleration_limit
+    counted = np.isfinite(limit) & (limit > 0)
+    if len(run.t) < 2 or len(q) < 3 or not np.any(counted):
+        return {"accel_rms_ratio": 0.0, "saturated_fraction": 0.0}
+    motion = robot.difference(q[1:], q[:-1])
+    ratio = np.abs(np.diff(motion, axis=0))[-len(run.t) :, counted] / (
+        (run.t[1] - run.t[0]) ** 2 * limit[counted]
+    )
+    ratio = ratio[settled[-len(ratio) :]]
+    if not ratio.size:
+        return {"accel_rms_ratio": 0.0, "saturated_fraction": 0.0}
+    return {
+        "accel_rms_ratio": float(np.sqrt(np.mean(ratio**2))),
+        "saturated_fraction": float(np.mean(np.any(ratio >= SATURATED, axis=1))),
+    }
 
 
 def _max_rate_ratio(run: PlanResult, robot: RobotModel, order: int, limit: np.ndarray) -> float:

@@ -4,15 +4,24 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Annotated
+from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import Field
 
 from articula.planning import baornn_kernel as kernel
+from articula.planning.clearance import EndEffector, RowSource
+from articula.planning.newton_step import task_residual
 from articula.planning.objective import NO_STOP, Box, Objective, Stop
 from articula.planning.planner import WARM_UP_STEPS
 from articula.planning.rate_limits import RateLimits
+from articula.planning.slide import SLIDE_MARGIN
+from articula.planning.smooth import (
+    PENALTY_REACH,
+    SMOOTH_BAND,
+    penalty_gradient,
+    smooth_change,
+)
 from articula.planning.task import Target, Task, as_target
 from articula.scene.scene import Scene
 from articula.validation import Positive, StrictModel
@@ -25,11 +34,15 @@ class BaornnParams(StrictModel):
         c1: antenna length λ_k = c1·√g_k, Eq. (1.23) [rad/√m].
         c2: step δ_k = c2·λ_k, Eq. (1.24) [-].
         iterations_per_step: iterations per control period.
+        smoothing: "acceleration": each period ends at the smallest change of motion that
+            meets the task from the search's point (planning/smooth.py, beyond the book);
+            "none": where the search left it, as Algorithm 1 (the book's commands).
     """
 
     c1: Positive = 0.5
     c2: Positive = 0.5
     iterations_per_step: Annotated[int, Field(ge=1, le=10_000)] = 10
+    smoothing: Literal["acceleration", "none"] = "acceleration"
 
 
 @dataclass
@@ -57,6 +70,10 @@ class BeetleSearch:
     infeasible: int = field(default=0, init=False)
     _box: Box | None = field(default=None, init=False, repr=False)  # this period's reach
     _stop: Stop = field(default=NO_STOP, init=False, repr=False)  # its braking check
+    _rows: RowSource = field(init=False, repr=False)  # clearance rows and task Jacobian
+
+    def __post_init__(self) -> None:
+        self._rows = RowSource(self.objective.scene, evaluation=self.objective.evaluation)
 
     def reset(self) -> None:
         """Forget the previous periods: the arm starts at rest."""
@@ -126,6 +143,43 @@ class BeetleSearch:
             NO_STOP if change is None else Stop(q, change, self.objective.sweep, last, jerk)
         )
         return True
+
+    def _smooth(
+        self, start: np.ndarray, q: np.ndarray, g: float, target: Target, t: float
+    ) -> tuple[np.ndarray, float]:
+        """The period's end re-chosen to use as little of the acceleration limits as the task
+        allows from the search's (q, g) (planning/smooth.py), projected onto Ω (1.17) with the
+        braking check; returns the period's (q, g). Without acceleration limits, with smoothing
+        "none", or where the search's point or the smoothed one is outside Ω, the search's."""
+        rate, obj = self.rate, self.objective
+        if self.params.smoothing == "none" or rate is None or not math.isfinite(g):
+            return q, g
+        scale = rate.change
+        if scale is None or not np.all(np.isfinite(scale) & (scale > 0)):
+            return q, g
+        coast = start if rate.last_motion is None else start + rate.last_motion
+        floors = (obj.d_min, obj.self_d_min)
+        reach = max(max(floors) + SLIDE_MARGIN + SMOOTH_BAND, PENALTY_REACH)
+        end, rows = self._rows(q, t, reach)
+        A, residual = self._task_rows(end, target)
+        low, high = (bound - coast for bound in self._box)
+        push = penalty_gradient(rows, obj.lambda_weight, obj.beta)
+        change = smooth_change(
+            q - coast, coast - start, scale, A, residual, rows, floors, low, high, push
+        )
+        self.evaluations += 1
+        if change is None:
+            return q, g
+        # Refused (outside Ω, or braking from it would leave Ω): the search's point.
+        return obj.project_and_value(coast + change, q, g, target, t, self._box, self._stop)
+
+    def _task_rows(self, end: EndEffector, target: Target) -> tuple[np.ndarray, np.ndarray]:
+        """(A, r): the task's Jacobian rows [m/rad] and residual [m] at the end effector."""
+        r = kernel.Reference(*self.objective.reference(target))
+        return task_residual(
+            end.x, np.ascontiguousarray(end.R), end.J,
+            r.task, r.weight, r.position, r.tool_axis, r.rotation, r.axis,
+        )  # fmt: skip
 
     def _end_period(self, start: np.ndarray, q: np.ndarray, g: float) -> np.ndarray:
         """Remember the period's motion for the acceleration limit, count it when it ended
@@ -197,6 +251,7 @@ class Baornn(BeetleSearch):
         begun = self._begin_period(q, target, t)
         q, g = (q, obj.value(q, target, t)) if begun is None else begun
         q, g = self._iterations(q, g, target, t, self.params.iterations_per_step)
+        q, g = self._smooth(start, q, g, target, t)
         return self._end_period(start, q, g)
 
     def _iterations(

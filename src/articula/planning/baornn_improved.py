@@ -46,8 +46,8 @@ from pydantic import Field
 
 from articula.planning import baornn_kernel as kernel
 from articula.planning.baornn import BaornnParams, BeetleSearch
-from articula.planning.clearance import RowSource
-from articula.planning.newton_step import newton_candidate, penalty_flat, task_residual
+from articula.planning.clearance import EndEffector
+from articula.planning.newton_step import newton_candidate, penalty_flat
 from articula.planning.slide import SLIDE_MARGIN, slide_correction
 from articula.planning.task import Target, as_target
 
@@ -97,10 +97,6 @@ class ImprovedBaornn(BeetleSearch):
 
     params: ImprovedParams
     _last_motion: np.ndarray | None = field(default=None, init=False)
-    _rows: RowSource = field(init=False, repr=False)  # clearance rows for change 8
-
-    def __post_init__(self) -> None:
-        self._rows = RowSource(self.objective.scene, evaluation=self.objective.evaluation)
 
     def iterate(
         self, q: np.ndarray, g: float, target: Target | np.ndarray, t: float
@@ -203,6 +199,7 @@ class ImprovedBaornn(BeetleSearch):
         q, g = self._search(q, math.nan, warm, target, draws, t, period=True)
         if p.slide_reach > 0:
             q, g = self._slide(q, g, target, t)
+        q, g = self._smooth(start, q, g, target, t)
         self._last_motion = q - start
         return self._end_period(start, q, g)
 
@@ -278,11 +275,11 @@ class ImprovedBaornn(BeetleSearch):
             return q, g
         floors = (obj.d_min, obj.self_d_min)
         reach = max(floors) + SLIDE_MARGIN + p.slide_reach
-        _, rows = self._rows(q, t, reach)
+        end, rows = self._rows(q, t, reach)
         floor = np.where(rows.self_pair, floors[1], floors[0])
         if not np.any(rows.distance < floor + p.slide_reach):
             return q, g  # nothing near its floor: the search alone decides
-        A, residual = self._task_rows(q, target)
+        A, residual = self._task_rows(end, target)
         model = obj.scene.robot.model
         low, high = self._box or (model.lowerPositionLimit, model.upperPositionLimit)
         step = slide_correction(
@@ -296,19 +293,11 @@ class ImprovedBaornn(BeetleSearch):
             return q_s, g_s
         return q, g
 
-    def _task_rows(self, q: np.ndarray, target: Target) -> tuple[np.ndarray, np.ndarray]:
-        """(A, r): the task's Jacobian rows [m/rad] and residual [m] at q (Pinocchio's)."""
-        robot = self.objective.scene.robot
-        pose = robot.ee_pose(q)
-        r = kernel.Reference(*self.objective.reference(target))
-        return task_residual(
-            pose[:3, 3].copy(), np.ascontiguousarray(pose[:3, :3]), robot.jacobian(q),
-            r.task, r.weight, r.position, r.tool_axis, r.rotation, r.axis,
-        )  # fmt: skip
-
     def _newton(self, q: np.ndarray, target: Target, damping: float) -> np.ndarray:
         """The Gauss-Newton candidate from q [rad] (change 6), Pinocchio's Jacobian."""
-        model = self.objective.scene.robot.model
-        A, residual = self._task_rows(q, target)
-        box = self._box or (model.lowerPositionLimit, model.upperPositionLimit)
+        robot = self.objective.scene.robot
+        pose = robot.ee_pose(q)
+        end = EndEffector(pose[:3, 3].copy(), pose[:3, :3].copy(), robot.jacobian(q))
+        A, residual = self._task_rows(end, target)
+        box = self._box or (robot.model.lowerPositionLimit, robot.model.upperPositionLimit)
         return newton_candidate(q, A, residual, damping, *box)

@@ -13,7 +13,7 @@ import numpy as np
 
 from articula.numba_cache import jit
 from articula.planning.newton_step import newton_from_chain, penalty_flat
-from articula.planning.rate_limits import braking_after, braking_path
+from articula.planning.rate_limits import braking_path
 from articula.planning.task import orientation_error
 from articula.scene.compiled_clearance import _evaluate
 
@@ -105,10 +105,11 @@ def _task_error(ee, ee_R, reference):
 @jit()
 def stoppable(clipped, d, d_self, d_min, self_d_min, stop, clearance, static_min):
     """Whether the arm, at `clipped` after this period's motion from stop's q_base, stays in Ω
-    while every joint then brakes as hard as its limits let it: where it stops, or, with a
-    jerk limit (braking that first ramps up, so longer), at the end of every braking period
-    (rate_limits.braking_path); a point is measured only where the clearance left since the
-    last measured one could be used up on the way.
+    while every joint then brakes as hard as its limits let it: at the end of every braking
+    period (rate_limits.braking_path; the joints stop at different times, and the clearance
+    between can be lower than at either end); a point is measured only where the clearance
+    left since the last measured one could be used up on the way (a link pair's distance
+    changes up to twice as fast as a link's to an obstacle).
 
     Args:
         clipped: the configuration at the end of the period, shape (nq,) [rad].
@@ -130,12 +131,8 @@ def stoppable(clipped, d, d_self, d_min, self_d_min, stop, clearance, static_min
     q_base, change, sweep, last, jerk = stop
     if change.size == 0:
         return True
-    motion = clipped - q_base
-    if jerk.size == 0:  # braking at once: where it stops (each joint monotone on the way)
-        path = braking_after(motion, last, change, jerk).reshape(1, clipped.size)
-    else:  # braking ramped up: each period's end, as the period's own end is checked
-        path = braking_path(motion, last, change, jerk)
-    room = min(d - d_min, d_self - max(self_d_min, SELF_CONTACT_MARGIN))
+    path = braking_path(clipped - q_base, last, change, jerk)
+    room = min(d - d_min, 0.5 * (d_self - max(self_d_min, SELF_CONTACT_MARGIN)))
     before = clipped
     for k in range(path.shape[0]):
         q_k = clipped + path[k]
@@ -145,7 +142,7 @@ def stoppable(clipped, d, d_self, d_min, self_d_min, stop, clearance, static_min
             d_k, d_self_k, _, _ = _evaluate(q_k, clearance, static_min)
             if outside_omega(d_k, d_self_k, d_min, self_d_min):
                 return False
-            room = min(d_k - d_min, d_self_k - max(self_d_min, SELF_CONTACT_MARGIN))
+            room = min(d_k - d_min, 0.5 * (d_self_k - max(self_d_min, SELF_CONTACT_MARGIN)))
         before = q_k
     return True
 

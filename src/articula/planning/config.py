@@ -139,6 +139,8 @@ class PlannerSpec(StrictModel):
         flat_penalty_slope: the penalty slope Λβ/d^(β+1) below which baornn-improved tries
             the Gauss-Newton step and may stop early; 0: never [-].
         slide_reach: nearness to d_min or self_d_min where baornn-improved slides; 0: never [m].
+        smoothing: "acceleration": BAORNN's period ends where g descends with the least
+            acceleration (planning/smooth.py); "none": where the search left it (the book's).
         gain: K on the task error, baselines [1/s].
         damping: μ of damped least squares, dls [m].
         repulsion: η of the obstacle repulsion, pinv and dls [m²/s].
@@ -186,6 +188,7 @@ class PlannerSpec(StrictModel):
     quiet_error: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 1e-5
     flat_penalty_slope: Annotated[float, Field(ge=0)] = 0.1
     slide_reach: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.01
+    smoothing: Literal["acceleration", "none"] = "acceleration"
     gain: NonNegative = 20.0
     damping: NonNegative = 0.02
     repulsion: NonNegative = 0.02

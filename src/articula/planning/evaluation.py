@@ -9,7 +9,7 @@ import numpy as np
 import pinocchio as pin
 
 from articula.planning.baornn_kernel import outside_omega, stoppable
-from articula.planning.rate_limits import braking_after, braking_path
+from articula.planning.rate_limits import braking_path
 from articula.scene.compiled_clearance import CompiledClearance
 from articula.scene.scene import Scene
 
@@ -118,8 +118,8 @@ class SceneEvaluation:
     def brakes_clear(
         self, q: np.ndarray, d: float, d_self: float, stop: tuple, t: float, omega: tuple
     ) -> bool:
-        """Whether braking from q stays inside Ω (baornn_kernel.stoppable's points, each
-        measured).
+        """Whether braking from q stays inside Ω (baornn_kernel.stoppable's points: the end of
+        every braking period, each measured).
 
         Args:
             q: joint angles at the end of the period, shape (nq,) [rad].
@@ -134,12 +134,7 @@ class SceneEvaluation:
         """
         d_min, self_d_min, obstacles = omega
         q_base, change, _, last, jerk = stop
-        motion = q - q_base
-        if jerk.size:
-            path = braking_path(motion, last, change, jerk)
-        else:  # braking at once: where it stops (as baornn_kernel.stoppable)
-            path = braking_after(motion, last, change, jerk)[None]
-        for offset in path:
+        for offset in braking_path(q - q_base, last, change, jerk):
             d_k, d_self_k = self.scene.clearances(q + offset, t)
             if outside_omega(d_k if obstacles else np.inf, d_self_k, d_min, self_d_min):
                 return False

@@ -1,0 +1,125 @@
+"""Smooth commands: the searches' period end re-chosen to use as little of the acceleration
+limits as the task allows (beyond the book; docs/deviations.md, issue 43).
+
+BAORNN's antennae are far longer than one period's change of motion (a·dt²), so the accepted
+point lands on a face of the period's box: the faithful search commanded ≥ 0.9 of the
+acceleration limit in 84-88 % of its settled periods, its sign reversing at ~20 Hz, and the
+redundancy's motion is the noise of a random search. Here the period ends instead at the
+change of motion Δ (from coasting: the start plus the last period's motion) that
+- meets the task from the search's point to first order (the search's point is where the
+  task and the clearance rows are linearised);
+- keeps every near pair above its floor to first order, and stays in the period's box;
+- moves the redundancy down the gradient of g's penalty (Eqs. 1.11, 1.14) at a rate set by
+  PENALTY_SCALE, its velocity damped by DAMPING per period: a smooth, deterministic descent
+  of the penalty the search descends by random antennae;
+- within those, uses the least of each joint's acceleration limit.
+The result is projected onto Ω with the braking check like any candidate, and the search's
+own point is kept when it is refused.
+"""
+
+from __future__ import annotations
+
+import daqp
+import numpy as np
+
+from articula.planning.clearance import ClearanceRows
+from articula.planning.slide import SLIDE_MARGIN
+
+# How much of g a full change of motion on one joint costs [m]: the penalty's slope times the
+# joints' largest changes, over this, is the redundancy's push per period [-].
+ACCELERATION_COST = 3e-5
+# g's tracking term |e| (Eq. 1.11) is weighed as |e_new|² / (2 max(|e|, ERROR_FLOOR)): equal
+# to |e| and of slope 1 where the search's point is, so that error is traded for clearance as
+# g trades it; on the path, of slope |e| / ERROR_FLOOR [m].
+ERROR_FLOOR = 1e-5
+# Share of the redundancy's velocity (the motion the task does not see) lost per period [-].
+DAMPING = 0.2
+# Rows within this much of their floor constrain the change [m] (the period's box moves a link
+# by a few mm at most).
+SMOOTH_BAND = 0.02
+# Obstacle rows within this distance push the redundancy [m]; beyond it Λ/d changes little.
+PENALTY_REACH = 0.25
+# The penalty's nearest distance (Eq. 1.14) as a soft minimum of this width over the rows [m],
+# so that two obstacles at nearly the same distance do not switch the push every period.
+SOFT_MIN = 0.005
+
+
+def penalty_gradient(rows: ClearanceRows, lambda_weight: float, beta: float) -> np.ndarray:
+    """∂/∂q of g's penalty Λ / d^β, d the nearest link-obstacle distance (Eqs. 1.11, 1.14),
+    the nearest row's gradient replaced by a soft minimum (SOFT_MIN) over the rows.
+
+    Args:
+        rows: the clearance rows at q (link-link rows are not penalised).
+        lambda_weight: Λ [m^(1+β)].
+        beta: β.
+
+    Returns:
+        The gradient, shape (nq,) [m/rad]; zeros without Λ or obstacle rows.
+    """
+    obstacle = ~rows.self_pair & (rows.distance > 0)
+    if lambda_weight == 0 or not np.any(obstacle):
+        return np.zeros(rows.gradient.shape[1])
+    d, gradient = rows.distance[obstacle], rows.gradient[obstacle]
+    near = d.min()
+    w = np.exp(-(d - near) / SOFT_MIN)
+    return -lambda_weight * beta / near ** (beta + 1) * (w @ gradient) / w.sum()
+
+
+def smooth_change(
+    searched: np.ndarray,
+    coasting: np.ndarray,
+    scale: np.ndarray,
+    task_jacobian: np.ndarray,
+    residual: np.ndarray,
+    rows: ClearanceRows,
+    floors: tuple[float, float],
+    low: np.ndarray,
+    high: np.ndarray,
+    push: np.ndarray,
+) -> np.ndarray | None:
+    """The period's change of motion Δ [rad] from coasting that descends g to first order from
+    the search's point q_s with the least acceleration: with u = Δ/c, Δ' = Δ − Δ_s, it
+    minimises |r − JΔ'|² / (2 max(|r|, ERROR_FLOOR)) + ∇P·Δ' + ACCELERATION_COST·(½Σu_i² +
+    ½·DAMPING·|N(m/c + u)|²), N the projection onto the task's null space (in u), subject to
+    ∇d_i·Δ' ≥ floor_i + SLIDE_MARGIN − d_i for every row within SMOOTH_BAND of its floor and
+    low ≤ Δ ≤ high.
+
+    Args:
+        searched: the search's change of motion Δ_s (its point minus coasting), shape (nq,)
+            [rad].
+        coasting: the last period's motion m, shape (nq,) [rad].
+        scale: each joint's largest change of motion per period, c = a·dt², shape (nq,) [rad].
+        task_jacobian: J of the task's rows at q_s, shape (m, nq) [m/rad].
+        residual: r, the task's residual there, shape (m,) [m].
+        rows: the clearance rows at q_s.
+        floors: (d_min, self_d_min) [m].
+        low: the smallest change each joint may take (the period's box minus coasting),
+            shape (nq,) [rad].
+        high: the largest, shape (nq,) [rad].
+        push: ∇P, the penalty's gradient at q_s (penalty_gradient), shape (nq,) [m/rad].
+
+    Returns:
+        Δ, shape (nq,) [rad]; None when no change within [low, high] keeps the rows (to first
+        order).
+    """
+    n = scale.size
+    M = task_jacobian * scale  # the task's rows per unit of each joint's limit
+    wanted = residual + task_jacobian @ searched
+    # The error where coasting ends, to first order: the search's own error is its noise.
+    fit = ACCELERATION_COST * max(float(np.linalg.norm(wanted)), ERROR_FLOOR)
+    free = np.eye(n) - np.linalg.pinv(M) @ M  # the redundancy, in u
+    damp = DAMPING * free.T @ free
+    H = M.T @ M / fit + np.eye(n) + damp
+    f = -M.T @ wanted / fit + (push * scale) / ACCELERATION_COST + damp @ (coasting / scale)
+    floor = np.where(rows.self_pair, floors[1], floors[0]) + SLIDE_MARGIN
+    near = rows.distance < floor + SMOOTH_BAND
+    G = rows.gradient[near]
+    need = floor[near] - rows.distance[near] + G @ searched
+    A = np.ascontiguousarray(G * scale)
+    upper = np.concatenate([high / scale, np.full(need.size, 1e30)])
+    lower = np.concatenate([low / scale, need])
+    sense = np.zeros(upper.size, dtype=np.intc)
+    u, _, status, _ = daqp.solve(H, f, A, upper, lower, sense)
+    if status <= 0:
+        return None
+    return np.clip(u * scale, low, high)
