@@ -92,13 +92,18 @@ _FRANKA = (
 _PANDA = f"{_FRANKA}, Limits for Panda"
 _FR3 = (
     f"{_FRANKA}, Limits for Franka Research 3 (rectangular speed limits); franka_description "
-    "robots/fr3/joint_limits.yaml; libfranka include/franka/rate_limiting.h"
+    "robots/fr3/joint_limits.yaml; libfranka include/franka/rate_limiting.h (FR3 releases)"
 )
-_UR_E = "UR {} User Manual, e-Series, version 5.8; UR support article Max. joint torques"
-_UR_CB3 = "UR {} User Manual, CB3, version 3.13; UR support article Max. joint torques"
+_UR_MANUALS = "https://s3-eu-west-1.amazonaws.com/ur-support-site/"
+_UR = (
+    "{} User Manual ({}); UR support article Max. joint torques "
+    "(https://www.universal-robots.com/articles/ur-articles/max-joint-torques); as in "
+    "Universal_Robots_ROS2_Description config/{}/joint_limits.yaml"
+)
 _KINOVA = (
-    "Kinova ros2_kortex kortex_description/arms/gen3/7dof/urdf/gen3_macro.xacro; ros_kortex "
-    "GEN3_URDF_V12.urdf (ranges of joints 2, 4, 6)"
+    "Kinova, github.com/Kinovarobotics/ros2_kortex kortex_description/arms/gen3/7dof/urdf/"
+    "gen3_macro.xacro; github.com/Kinovarobotics/ros_kortex kortex_description/arms/gen3/7dof/"
+    "urdf/GEN3_URDF_V12.urdf (ranges of joints 2, 4, 6)"
 )
 _TURN = 2 * math.pi  # [rad] UR's ±360°
 _HALF = math.pi  # [rad/s] 180°/s
@@ -106,8 +111,10 @@ _THIRD = 2 * math.pi / 3  # [rad/s] 120°/s
 _NONE6: Limits = (None,) * 6
 
 
-def _ur(name: str, arm: str, source: str, velocity: Limits, effort: Limits) -> Datasheet:
-    """A Universal Robots arm: every joint ±360°, no published acceleration or jerk."""
+def _ur(name: str, arm: str, manual: str, velocity: Limits, effort: Limits) -> Datasheet:
+    """A Universal Robots arm: every joint ±360°, no published acceleration or jerk; its
+    user manual at UR's support site path `manual`."""
+    source = _UR.format(arm, _UR_MANUALS + manual, name)
     return Datasheet(
         name, arm, source, (-_TURN,) * 6, (_TURN,) * 6, velocity, _NONE6, _NONE6, effort
     )
@@ -135,17 +142,17 @@ DATASHEETS: dict[str, Datasheet] = {sheet.name: sheet for sheet in (
         effort=(87.0, 87.0, 87.0, 87.0, 12.0, 12.0, 12.0),
         joint_names=tuple(f"fr3_joint{i}" for i in range(1, 8)),
     ),
-    _ur("ur3e", "Universal Robots UR3e", _UR_E.format("UR3e"),
+    _ur("ur3e", "Universal Robots UR3e", "69043/99403_UR3e_User_Manual_en_Global.pdf",
         (_HALF, _HALF, _HALF, _TURN, _TURN, _TURN), (56.0, 56.0, 28.0, 12.0, 12.0, 12.0)),
-    _ur("ur5e", "Universal Robots UR5e", _UR_E.format("UR5e"),
+    _ur("ur5e", "Universal Robots UR5e", "69091/99404_UR5e_User_Manual_en_Global.pdf",
         (_HALF,) * 6, (150.0, 150.0, 150.0, 28.0, 28.0, 28.0)),
-    _ur("ur10e", "Universal Robots UR10e", _UR_E.format("UR10e"),
+    _ur("ur10e", "Universal Robots UR10e", "69139/99405_UR10e_User_Manual_en_Global.pdf",
         (_THIRD, _THIRD, _HALF, _HALF, _HALF, _HALF), (330.0, 330.0, 150.0, 56.0, 56.0, 56.0)),
-    _ur("ur16e", "Universal Robots UR16e", _UR_E.format("UR16e"),
+    _ur("ur16e", "Universal Robots UR16e", "69187/99473_UR16e_User_Manual_en_Global.pdf",
         (_THIRD, _THIRD, _HALF, _HALF, _HALF, _HALF), (330.0, 330.0, 150.0, 54.0, 54.0, 54.0)),
-    _ur("ur5", "Universal Robots UR5 (CB3)", _UR_CB3.format("UR5"),
+    _ur("ur5", "Universal Robots UR5 (CB3)", "69371/99202_UR5_User_Manual_en_Global.pdf",
         (_HALF,) * 6, (150.0, 150.0, 150.0, 28.0, 28.0, 28.0)),
-    _ur("ur10", "Universal Robots UR10 (CB3)", _UR_CB3.format("UR10"),
+    _ur("ur10", "Universal Robots UR10 (CB3)", "69442/99203_UR10_User_Manual_en_Global.pdf",
         (_THIRD, _THIRD, _HALF, _HALF, _HALF, _HALF), (330.0, 330.0, 150.0, 56.0, 56.0, 56.0)),
     # Ranges of joints 2, 4, 6 from GEN3_URDF_V12.urdf; the Gen3 user guide's own table could
     # not be read to check them, and a later ros2_kortex macro narrows joint 2 to ±1.4 rad
