@@ -10,8 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from articula.errors import ConfigError
+from articula.errors import ConfigError, InfeasibleError
 from articula.experiments.plan import PlanConfig, run_plan
+from articula.loops.online import OnlineController
 from articula.planning.kept_limits import kept_limits
 from articula.robots.datasheets import DATASHEETS, datasheet, match_joint_names
 from articula.robots.limits import published_or_rule, tighter
@@ -97,6 +98,14 @@ def test_the_panda_s_joint_names_bring_franka_s_limits():
     assert robot.upper[3] == -0.0698 and robot.lower[5] == -0.0175
     assert robot.limit_sources["position"] == tuple(PANDA_SHEET)
     np.testing.assert_array_equal(robot.model.effortLimit, [87.0] * 4 + [12.0] * 3)
+
+
+def test_a_start_the_urdf_allows_but_franka_does_not_is_refused_naming_the_source():
+    scene, q0 = build_scene(config(), Path("."))
+    controller = OnlineController.from_spec(scene, config(method="qp").planner)
+    q0[3] = -0.03  # within the URDF's joint 4 (up to 0), beyond Franka's -0.0698
+    with pytest.raises(InfeasibleError, match=r"panda_joint4 = -0.0300 .*datasheet franka-panda"):
+        controller.reset(q0)
 
 
 def test_without_a_datasheet_the_urdf_and_the_default_rules_hold():
