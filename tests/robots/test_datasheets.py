@@ -81,9 +81,12 @@ def test_tighter_takes_the_smaller_limit_and_names_the_one_that_binds():
 
 def test_published_or_rule_falls_back_to_the_rise_time_per_joint():
     values, sources = published_or_rule([5.0, None], np.array([2.0, 1.0]), 0.25, "accel_time",
-                                        "datasheet x")  # fmt: skip
+                                        "x")  # fmt: skip
     np.testing.assert_array_equal(values, [5.0, 4.0])
     assert sources == ("datasheet x", "default rule (accel_time = 0.25 s)")
+    values, sources = published_or_rule(None, np.array([2.0, 0.0]), 0.5, "jerk_time", None)
+    np.testing.assert_array_equal(values, [4.0, np.inf])  # no speed limit: no acceleration's
+    assert sources == ("default rule (jerk_time = 0.5 s)",) * 2
 
 
 def test_the_panda_s_joint_names_bring_franka_s_limits():

@@ -129,7 +129,7 @@ def published_or_rule(
     below: np.ndarray,
     rise_time: float,
     key: str,
-    source: str,
+    name: str | None,
 ) -> tuple[np.ndarray, tuple[str, ...]]:
     """Per joint, a datasheet's limit where it publishes one, else the limit `below` reached
     from zero in rise_time (`rise_limit`); with each one's source.
@@ -139,7 +139,7 @@ def published_or_rule(
         below: the limits of the derivative below, shape (nq,) (e.g. speeds [rad/s]).
         rise_time: time from zero to a `below` limit [s].
         key: the setting rise_time came from ("accel_time" or "jerk_time").
-        source: the datasheet's source (`sheet_source`).
+        name: the datasheet's name (None without one).
 
     Returns:
         The limits, shape (nq,), and one source per joint.
@@ -148,5 +148,6 @@ def published_or_rule(
     if published is None:
         return rule, (rule_source(key, rise_time),) * rule.size
     values = np.array([r if p is None else p for p, r in zip(published, rule, strict=True)])
+    source = sheet_source(name or "")
     sources = tuple(rule_source(key, rise_time) if p is None else source for p in published)
     return values, sources

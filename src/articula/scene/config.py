@@ -15,7 +15,7 @@ from articula.geometry.poses import pose
 from articula.geometry.shapes import ConvexShape, box, capsule, cylinder, sphere
 from articula.limits import MAX_DECOMPOSE_VERTICES, MAX_LENGTH, MAX_LINKS, MAX_SCALE, MIN_SCALE
 from articula.robots.datasheets import Datasheet, apply_datasheet
-from articula.robots.limits import ACCEL_TIME, JERK_TIME, USER, published_or_rule, sheet_source
+from articula.robots.limits import ACCEL_TIME, JERK_TIME, USER, published_or_rule
 from articula.robots.model import RobotModel
 from articula.scene.obstacles import Obstacle
 from articula.scene.pairs import link_pairs
@@ -288,9 +288,8 @@ def _limit(
     attribute, key, time_key, unit = keys
     if stated is None:
         if sheet is None:
-            return published_or_rule(None, below, rise_time, time_key, "")
-        published = getattr(sheet, attribute)
-        return published_or_rule(published, below, rise_time, time_key, sheet_source(sheet.name))
+            return published_or_rule(None, below, rise_time, time_key, None)
+        return published_or_rule(getattr(sheet, attribute), below, rise_time, time_key, sheet.name)
     limits = np.asarray(stated, dtype=float)
     if limits.ndim == 0:
         return np.full(below.size, float(limits)), (USER,) * below.size
