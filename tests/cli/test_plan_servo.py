@@ -25,8 +25,15 @@ def test_a_servo_rate_writes_the_stream_and_the_limits(cli, tmp_path, one_json):
     assert proc.returncode == 0, proc.stderr
     record = one_json(proc.stdout)
     assert record["tables"] == ["servo.parquet"]
-    assert set(record["limits"]) == {"velocity", "acceleration", "jerk"}
-    assert all(len(v) == 7 for v in record["limits"].values())
+    limits = record["limits"]  # the iiwa14's, from its URDF and the default rules
+    assert set(limits) == {"velocity", "acceleration", "jerk", "sources", "datasheet"}
+    assert all(len(limits[k]) == 7 for k in ("velocity", "acceleration", "jerk"))
+    assert limits["datasheet"] is None
+    assert limits["sources"] == {
+        "velocity": ["urdf"] * 7,
+        "acceleration": ["default rule (accel_time = 0.25 s)"] * 7,
+        "jerk": ["default rule (jerk_time = 0.01 s)"] * 7,
+    }
     m = record["metrics"]
     assert m["servo_rate_hz"] == 500 and m["servo_max_jerk_ratio"] <= 1 + 1e-6
     assert m["max_jerk_ratio"] <= 1 + 1e-6

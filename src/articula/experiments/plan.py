@@ -33,6 +33,7 @@ from articula.planning.config import (
     make_planner,
     make_targets,
 )
+from articula.planning.kept_limits import kept_limits
 from articula.planning.planner import Planner
 from articula.planning.reach import check_reach
 from articula.planning.target_path import TargetPath
@@ -284,7 +285,8 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
     metrics |= stall_metrics(run, plan.scene, p.tolerance, p.d_min)
     why = _not_tracked(metrics, p, lead, len(run.t))
     metrics["tracked"] = why is None
-    details = {"limits": _limits(plan.scene)} | ({} if why is None else {"not_tracked": why})
+    details = {"limits": kept_limits(p, plan.scene.robot)}
+    details |= {} if why is None else {"not_tracked": why}
     trace = trace_columns(run)
     if arm is not None:
         metrics |= arm.metrics(run, plan.scene, p.settle or 0.0)
@@ -364,17 +366,6 @@ def load_plan(path: Path, servo_rate: float | None = None) -> dict[str, Any]:
     if servo_rate is not None:
         data["servo"] = {**data.get("servo", {}), "rate": servo_rate}
     return absolute_paths(data, path.parent)
-
-
-def _limits(scene: Scene) -> dict[str, list[float | None]]:
-    """The robot's joint limits for the record: velocity, acceleration, jerk per joint (SI;
-    None for none)."""
-    robot = scene.robot
-    limits = (robot.velocity_limit, robot.acceleration_limit, robot.jerk_limit)
-    return {
-        name: [float(v) if np.isfinite(v) and v > 0 else None for v in values]
-        for name, values in zip(("velocity", "acceleration", "jerk"), limits, strict=True)
-    }
 
 
 def _with_method(spec: PlannerSpec, method: str, where: str) -> PlannerSpec:

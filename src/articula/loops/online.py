@@ -149,8 +149,15 @@ class OnlineController:
         """
         scene, robot = self.planner.scene, self.planner.scene.robot
         start = robot.wrap(robot.check_q(q, "q0"))
-        if np.any(start < robot.lower) or np.any(start > robot.upper):
-            raise InfeasibleError("the start breaks the joint limits (Eq. 1.9)", "q0")
+        outside = np.flatnonzero((start < robot.lower) | (start > robot.upper))
+        if outside.size:
+            j = int(outside[0])  # the first, named with its range and where the range came from
+            raise InfeasibleError(
+                f"the start breaks the joint limits (Eq. 1.9): {robot.joint_names[j]} = "
+                f"{start[j]:.4f} outside [{robot.lower[j]:.4f}, {robot.upper[j]:.4f}] "
+                f"({robot.limit_sources['position'][j]}); move the start within them",
+                "q0",
+            )
         if scene.self_pairs:
             d_self = scene.self_distances(start)
             k = int(np.argmin(d_self))

@@ -149,13 +149,13 @@ class PlannerSpec(StrictModel):
         seed: seed of the planner's randomness; also accepted at the top of a plan config,
             where it wins (see PlanConfig).
         max_steps: most control periods a run may have (duration / dt).
-        limits: "velocity+acceleration": the URDF's joint speed limits (scaled) and the
+        limits: "velocity+acceleration": the robot's joint speed limits (scaled) and the
             robot's acceleration limits ([robot] acceleration_limits or accel_time), relative
             to the last period's motion; "velocity+acceleration+jerk": and the robot's jerk
             limits ([robot] jerk_limits or jerk_time), relative to the last two periods';
             "velocity": the speed limits alone; "none": BAORNN moves as fast as the book's
             Algorithm 1 (the baselines' solvers always keep the speed limits).
-        velocity_scale: fraction of the URDF joint speed limits, in (0, 1].
+        velocity_scale: fraction of the robot's joint speed limits, in (0, 1].
         max_acceleration: one acceleration limit for every joint that overrides the robot's
             (limits with "acceleration" only); None: the robot's [rad/s²].
         approach: "auto": when the path starts away from the tool, the reference first moves
@@ -273,7 +273,7 @@ def _params(model: type[StrictModel], spec: PlannerSpec, **extra: Any) -> Any:
 
 
 def rate_limits(spec: PlannerSpec, robot: RobotModel) -> RateLimits | None:
-    """The joint speed limits of `robot` (its URDF's, times velocity_scale; a joint without
+    """The joint speed limits of `robot` (URDF or datasheet, times velocity_scale; a joint without
     one has none) and, as spec.limits says, its acceleration (max_acceleration for every joint
     when given) and jerk limits, relative to the last periods' motions.
 

@@ -23,7 +23,7 @@ from articula.robots._urdf_kinematics import (
     _prepare_urdf,
     _unbounded,
 )
-from articula.robots.limits import ACCEL_TIME, JERK_TIME, rise_limit
+from articula.robots.limits import ACCEL_TIME, JERK_TIME, default_sources, rise_limit
 from articula.robots.urdf_geometry import collision_shapes
 
 BUILTIN = {"iiwa14": ("iiwa14/iiwa14.urdf", "iiwa_link_ee")}
@@ -70,6 +70,10 @@ class RobotModel:
         jerk_limit: joint jerk limits [rad/s³ or m/s³], inf for none; by default each
             acceleration limit reached from zero in JERK_TIME (scene files set it from
             [robot] jerk_limits or jerk_time).
+        limit_sources: where each joint limit came from, one source per joint for each of
+            "position", "velocity", "acceleration", "jerk", "effort" (robots.limits).
+        datasheet: the maker's datasheet whose limits were combined with the URDF's, and
+            how it was chosen; None: none (robots.datasheets, [robot] datasheet).
     """
 
     def __init__(
@@ -90,6 +94,8 @@ class RobotModel:
         self.continuous = np.array([name in continuous for name in self.joint_names], dtype=bool)
         self.acceleration_limit = rise_limit(model.velocityLimit, ACCEL_TIME)
         self.jerk_limit = rise_limit(self.acceleration_limit, JERK_TIME, "jerk_time")
+        self.limit_sources = default_sources(self.nq)
+        self.datasheet: str | None = None
 
     @classmethod
     def from_urdf(
@@ -228,7 +234,7 @@ class RobotModel:
 
     @property
     def velocity_limit(self) -> np.ndarray:
-        """Joint speed limits [rad/s or m/s] from the URDF."""
+        """Joint speed limits [rad/s or m/s]: the URDF's, or a datasheet's where tighter."""
         return self.model.velocityLimit.copy()
 
     def clip(self, q: np.ndarray) -> np.ndarray:

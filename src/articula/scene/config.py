@@ -14,7 +14,8 @@ from articula.geometry.meshes import convex_parts, load_mesh
 from articula.geometry.poses import pose
 from articula.geometry.shapes import ConvexShape, box, capsule, cylinder, sphere
 from articula.limits import MAX_DECOMPOSE_VERTICES, MAX_LENGTH, MAX_LINKS, MAX_SCALE, MIN_SCALE
-from articula.robots.limits import ACCEL_TIME, JERK_TIME, rise_limit
+from articula.robots.datasheets import Datasheet, apply_datasheet
+from articula.robots.limits import ACCEL_TIME, JERK_TIME, USER, published_or_rule
 from articula.robots.model import RobotModel
 from articula.scene.obstacles import Obstacle
 from articula.scene.pairs import link_pairs
@@ -72,14 +73,21 @@ class RobotSpec(StrictModel):
         self_collision: whether link-link distances are checked: every planner keeps the
             links of a checked pair self_d_min apart, and a step closer than 0 is a collision.
         self_d_min: clearance every planner keeps between the links of a checked pair [m].
+        datasheet: the arm's published limits (robots.datasheets: "franka-panda",
+            "franka-fr3", "ur3e", "ur5e", "ur10e", "ur16e", "ur5", "ur10", "kinova-gen3");
+            each position, speed and effort limit is the tighter of the datasheet's and the
+            URDF's, acceleration and jerk the datasheet's where it publishes them. None: the
+            datasheet the URDF's joint names identify (panda_joint1..7: franka-panda,
+            fr3_joint1..7: franka-fr3), else none; "none": no datasheet.
         acceleration_limits: joint acceleration limits, one for every joint or one per joint
-            [rad/s² or m/s²]; None: each joint's URDF speed limit over accel_time.
-        accel_time: time from rest to a joint's URDF speed limit when acceleration_limits
-            is not given [s].
+            [rad/s² or m/s²]; None: the datasheet's, else each joint's speed limit over
+            accel_time.
+        accel_time: time from rest to a joint's speed limit where neither acceleration_limits
+            nor the datasheet gives an acceleration limit [s].
         jerk_limits: joint jerk limits, one for every joint or one per joint [rad/s³ or
-            m/s³]; None: each acceleration limit over jerk_time.
-        jerk_time: time from zero to a joint's acceleration limit when jerk_limits is not
-            given [s].
+            m/s³]; None: the datasheet's, else each acceleration limit over jerk_time.
+        jerk_time: time from zero to a joint's acceleration limit where neither jerk_limits
+            nor the datasheet gives a jerk limit [s].
         allow_pairs: [a, b] link name pairs never checked for self-collision.
         self_collision_samples: random configurations the allowed-collision matrix is built on.
         self_collision_margin: a link pair never closer than this over the samples is not
@@ -101,6 +109,7 @@ class RobotSpec(StrictModel):
     # allowed-collision matrix; allow_pairs are never checked.
     self_collision: bool = True
     self_d_min: Annotated[float, Field(ge=0, le=MAX_LENGTH, allow_inf_nan=False)] = SELF_D_MIN
+    datasheet: str | None = None
     acceleration_limits: Positive | list[Positive] | None = None
     accel_time: Positive = ACCEL_TIME
     jerk_limits: Positive | list[Positive] | None = None
@@ -223,10 +232,13 @@ def build_scene(
                 offset,
                 decompose=r.decompose,
             )
-        robot.acceleration_limit = _limit(
-            r.acceleration_limits, robot.velocity_limit, r.accel_time, _ACCELERATION
+        sheet = apply_datasheet(robot, r.datasheet)
+        robot.acceleration_limit, robot.limit_sources["acceleration"] = _limit(
+            r.acceleration_limits, sheet, robot.velocity_limit, r.accel_time, _ACCELERATION
         )
-        robot.jerk_limit = _limit(r.jerk_limits, robot.acceleration_limit, r.jerk_time, _JERK)
+        robot.jerk_limit, robot.limit_sources["jerk"] = _limit(
+            r.jerk_limits, sheet, robot.acceleration_limit, r.jerk_time, _JERK
+        )
     q0 = robot.check_q(r.q0 if r.q0 is not None else np.zeros(robot.nq), "robot.q0")
     obstacles = []
     for i, o in enumerate(spec.obstacles):
@@ -258,30 +270,34 @@ def robot_self_collision(spec: SceneSpec, robot: RobotModel) -> SelfCollisionMat
         )
 
 
-# A [robot] limit's key, the key of its rise time, and its unit.
-_ACCELERATION = ("acceleration_limits", "accel_time", "rad/s²")
-_JERK = ("jerk_limits", "jerk_time", "rad/s³")
+# A limit's datasheet attribute, its [robot] key, the key of its rise time, and its unit.
+_ACCELERATION = ("acceleration", "acceleration_limits", "accel_time", "rad/s²")
+_JERK = ("jerk", "jerk_limits", "jerk_time", "rad/s³")
 
 
 def _limit(
     stated: float | list[float] | None,
+    sheet: Datasheet | None,
     below: np.ndarray,
     rise_time: float,
-    keys: tuple[str, str, str],
-) -> np.ndarray:
-    """A [robot] limit per joint: the stated one (one number or one per joint), else the limit
-    `below` reached from zero in rise_time (robots.limits.rise_limit)."""
-    key, time_key, unit = keys
+    keys: tuple[str, str, str, str],
+) -> tuple[np.ndarray, tuple[str, ...]]:
+    """A [robot] limit per joint and its sources: the stated one (one number or one per
+    joint), else the datasheet's where it publishes one, else the limit `below` reached from
+    zero in rise_time (robots.limits.published_or_rule)."""
+    attribute, key, time_key, unit = keys
     if stated is None:
-        return rise_limit(below, rise_time, time_key)
+        if sheet is None:
+            return published_or_rule(None, below, rise_time, time_key, None)
+        return published_or_rule(getattr(sheet, attribute), below, rise_time, time_key, sheet.name)
     limits = np.asarray(stated, dtype=float)
     if limits.ndim == 0:
-        return np.full(below.size, float(limits))
+        return np.full(below.size, float(limits)), (USER,) * below.size
     if limits.shape != below.shape:
         raise ConfigError(
             key, f"needs one number or {below.size}, one per joint [{unit}] (got {limits.size})"
         )
-    return limits
+    return limits, (USER,) * below.size
 
 
 def _obstacle(spec: ObstacleSpec, index: int, base_dir: Path) -> Obstacle:
