@@ -255,9 +255,13 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
             `tracked` (False when rms_error after `planner.settle` exceeds
             `planner.tolerance`, or, for a pose or axis task, rms_orientation_error
             `planner.orientation_tolerance`: the record's `not_tracked` then says why, with
-            the cause measured); and the trace columns of trace_columns (t [s], phase,
-            q_1..q_m [rad], x, y, z, their references x_ref, y_ref, z_ref, error and
-            clearance [m]).
+            the cause measured); with [servo], run_stream's metrics and the stream's
+            clearances at every sample (stream_min_clearance, ... of
+            loops.sampled_clearance), `tracked` False when they fall below a floor by more
+            than STREAM_TOLERANCE; with [plant], TwinArm.metrics (plant_rms_error, ...,
+            torque_saturated_s), `tracked` False on TwinArm.failure; and the trace columns of
+            trace_columns (t [s], phase, q_1..q_m [rad], x, y, z, their references x_ref,
+            y_ref, z_ref, error and clearance [m]).
 
     Raises:
         InfeasibleError: the path is out of the robot's reach.
