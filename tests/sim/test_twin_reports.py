@@ -180,3 +180,21 @@ def test_a_stream_that_dips_more_than_its_tolerance_exits_2_naming_it(
     assert len(captured.err.strip().splitlines()) == 1
     assert "servo stream" in captured.err and m["stream_min_clearance_pair"] in captured.err
     assert (out / "record.json").exists() and (out / "servo.parquet").exists()
+
+
+def test_the_twin_fails_on_saturation_then_clearance_then_error_and_leaves_contacts_to_exit_4():
+    ok = {"plant_contacts": 0.0, "torque_saturated_s": 0.0, "torque_saturated_joint": None,
+          "torque_saturated_joint_s": 0.0, "plant_min_clearance": 0.0195,
+          "plant_min_clearance_pair": "wrist_3_link / ball", "plant_min_clearance_at": 1.5,
+          "plant_min_self_clearance": None, "plant_rms_error": 0.004,
+          "plant_max_error": 0.006}  # fmt: skip
+    floors = (0.02, 0.005)
+    assert TwinArm.failure(ok, 0.005, floors) is None  # 0.5 mm below d_min: within 1 mm
+    far = ok | {"plant_rms_error": 0.0051}
+    assert "5.10 mm RMS" in TwinArm.failure(far, 0.005, floors)
+    close = far | {"plant_min_clearance": 0.0189}
+    assert "18.90 mm from wrist_3_link / ball" in TwinArm.failure(close, 0.005, floors)
+    held = close | {"torque_saturated_s": 0.25, "torque_saturated_joint": "elbow_joint",
+                    "torque_saturated_joint_s": 0.2}  # fmt: skip
+    assert "elbow_joint was at its effort limit for 0.200 s" in TwinArm.failure(held, 0.005, floors)
+    assert TwinArm.failure(held | {"plant_contacts": 2.0}, 0.005, floors) is None
