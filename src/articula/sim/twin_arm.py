@@ -204,7 +204,8 @@ class TwinArm:
                 f"the twin's {metrics['torque_saturated_joint']} was at its effort limit for "
                 f"{metrics['torque_saturated_joint_s']:.3f} s (some joint for "
                 f"{metrics['torque_saturated_s']:.3f} s): the motion asks more torque than "
-                "the URDF's effort allows; lower the acceleration or jerk limits"
+                "the URDF's effort allows; lower robot.acceleration_limits, "
+                "robot.jerk_limits or plant.stiffness, or check the URDF's effort limits"
             )
         cleared = clearance_failure(
             metrics, "plant", "the twin's measured arm", floors, PLANT_TOLERANCE
