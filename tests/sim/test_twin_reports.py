@@ -1,7 +1,10 @@
 """What the twin reports, and how it fails: a joint held at its effort limit exits 2 naming the
 joint (a UR10 whose URDF efforts are scaled down); the measured tool is compared with the
 reference at the same time (recomputed from the trace with Pinocchio on the URDF); the
-stream's braking tail is played, so the twin ends at rest where the stream stops."""
+stream's braking tail is played, so the twin ends at rest where the stream stops; the stream's
+clearance is the minimum over its samples (coal on the URDF's mesh hulls) and one below its
+floor exits 2 naming the pair; the twin's failures come in a stated order, contacts left to
+exit 4."""
 
 from __future__ import annotations
 
@@ -30,7 +33,7 @@ pytest.importorskip("mujoco", reason='the twin needs the `sim` extra: pip instal
 
 from articula.sim.twin_arm import TwinArm
 
-SCALE = 0.25  # of the UR10's effort limits: too little to hold its shoulder up
+SCALE = 0.25  # of the UR10's effort limits: less than the stream's peaks ask of the elbow
 
 
 def _weak_ur10(tmp_path: Path) -> tuple[Path, dict[str, float]]:
