@@ -94,7 +94,8 @@ def twin_runs():
 @pytest.mark.parametrize("method", ["qp", "baornn-improved"])
 def test_the_twin_touches_nothing_within_its_effort_limits(twin_runs, scene, method):
     m, trace, config, urdf, dirs = twin_runs(scene, method)
-    assert m["plant_contacts"] == 0 and m["max_torque_ratio"] <= 1.0
+    assert m["plant_contacts"] == 0 and m["max_torque_ratio"] < 1.0
+    assert m["torque_saturated_s"] == 0 and m["plant_final_speed"] < 1e-3
     qm = np.column_stack([trace[f"qm_{j + 1}"] for j in range(7)])
     clearance = _urdf_clearance(urdf, dirs, config, qm[::5])
     assert clearance > 0.0 and m["plant_min_clearance"] > 0.0

@@ -41,7 +41,9 @@ def plan(
     touching), or one the dynamics twin ([plant]) touches something in, still writes its run
     folder, then exits with status 4; one that does not track its path (planner.tolerance)
     writes it and exits with status 2, naming the cause measured (a stall at a boundary, a
-    start no step could leave, ...).
+    start no step could leave, ...), as does a servo stream that passes below a clearance
+    floor, or a twin that holds a joint at its effort limit, passes below a floor or strays
+    from the path (docs/guides/servo.md).
 
     \b
     Example: articula plan src/articula/book/ch1/configs/circle_two_obstacles.toml --out runs/circle

@@ -22,6 +22,7 @@ from pydantic import Field, model_validator
 from articula.errors import ConfigError
 from articula.limits import MAX_SERVO_SAMPLES
 from articula.loops.online import OnlineController
+from articula.loops.sampled_clearance import STREAM_TOLERANCE, clearance_failure, sampled_clearance
 from articula.loops.servo import run_stream, ticks_per_period
 from articula.loops.stall import not_tracked_cause, stall_metrics
 from articula.loops.tracking import trace_columns, track, tracking_metrics
@@ -255,9 +256,13 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
             `tracked` (False when rms_error after `planner.settle` exceeds
             `planner.tolerance`, or, for a pose or axis task, rms_orientation_error
             `planner.orientation_tolerance`: the record's `not_tracked` then says why, with
-            the cause measured); and the trace columns of trace_columns (t [s], phase,
-            q_1..q_m [rad], x, y, z, their references x_ref, y_ref, z_ref, error and
-            clearance [m]).
+            the cause measured); with [servo], run_stream's metrics and the stream's
+            clearances at every sample (stream_min_clearance, ... of
+            loops.sampled_clearance), `tracked` False when they fall below a floor by more
+            than STREAM_TOLERANCE; with [plant], TwinArm.metrics (plant_rms_error, ...,
+            torque_saturated_s), `tracked` False on TwinArm.failure; and the trace columns of
+            trace_columns (t [s], phase, q_1..q_m [rad], x, y, z, their references x_ref,
+            y_ref, z_ref, error and clearance [m]).
 
     Raises:
         InfeasibleError: the path is out of the robot's reach.
@@ -284,17 +289,23 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
     )
     metrics |= stall_metrics(run, plan.scene, p.tolerance, p.d_min)
     why = _not_tracked(metrics, p, lead, len(run.t))
+    trace, tables, floors = trace_columns(run), {}, (p.d_min, plan.scene.self_d_min)
+    if config.servo is not None:
+        stream, servo = run_stream(run, plan.scene.robot, config.servo.rate)
+        metrics |= servo | sampled_clearance(plan.scene, stream.q, stream.t, "stream")
+        tables = {SERVO: stream.columns()}
+        why = why or clearance_failure(
+            metrics, "stream", "the servo stream", floors, STREAM_TOLERANCE
+        )
+    if arm is not None:
+        arm.brake()  # the stream's tail, as sent to the arm
+        metrics |= arm.metrics(run, plan.scene, p.settle or 0.0)
+        trace |= arm.columns()
+        why = why or arm.failure(metrics, p.tolerance, floors)
     metrics["tracked"] = why is None
     details = {"limits": kept_limits(p, plan.scene.robot)}
     details |= {} if why is None else {"not_tracked": why}
-    trace = trace_columns(run)
-    if arm is not None:
-        metrics |= arm.metrics(run, plan.scene, p.settle or 0.0)
-        trace |= arm.columns()
-    if config.servo is None:
-        return Result(metrics, trace, details=details)
-    stream, servo = run_stream(run, plan.scene.robot, config.servo.rate)
-    return Result(metrics | servo, trace, tables={SERVO: stream.columns()}, details=details)
+    return Result(metrics, trace, tables=tables, details=details)
 
 
 def _not_tracked(metrics: dict[str, Any], p: PlannerSpec, lead: float, periods: int) -> str | None:
