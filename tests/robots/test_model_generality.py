@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from articula.errors import ConfigError
@@ -47,6 +47,8 @@ def test_wrap_turns_a_continuous_joint_by_whole_turns_into_the_half_open_period(
         [math.pi, -math.pi, 3 * math.pi, math.nextafter(math.pi, 4), math.nextafter(-math.pi, -4)]
     )
 
+    # No wall-clock limits: the machine is shared.
+    @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(st.lists(angles, min_size=3, max_size=3))
     def wraps(values: list[float]) -> None:
         q = np.array(values)
