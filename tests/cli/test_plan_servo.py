@@ -45,9 +45,28 @@ def test_a_servo_rate_writes_the_stream_and_the_limits(cli, tmp_path, one_json):
     assert is_finished(out)
     (out / "servo.parquet").unlink()
     assert not is_finished(out)  # the record lists it: the run is recomputed on resume
-    proc = cli("plan", scene, "--out", out, "--json")  # the same folder, no stream this time
+    proc = cli("plan", scene, "--out", out)  # the same folder, no stream this time
     assert proc.returncode == 0, proc.stderr
-    assert "tables" not in json.loads(proc.stdout) and not (out / "servo.parquet").exists()
+    record = json.loads((out / "record.json").read_text())
+    assert "tables" not in record and not (out / "servo.parquet").exists()
+    line = " ".join(proc.stdout.split())  # rich wraps to the terminal width
+    assert f"max {1e3 * record['metrics']['max_error']:.3f} mm" in line
+    assert "servo at" not in line and "twin:" not in line  # only what the record has
+
+
+def test_the_line_gives_the_streams_acceleration_and_jerk_ratios(cli, tmp_path):
+    scene = tmp_path / "scene.toml"
+    scene.write_text(STREAMED.format(trajectory=CIRCLE, method="qp"))
+    out = tmp_path / "run"
+    proc = cli("plan", scene, "--out", out, "--servo-rate", "1000")
+    assert proc.returncode == 0, proc.stderr
+    m = json.loads((out / "record.json").read_text())["metrics"]
+    line = " ".join(proc.stdout.split())
+    assert (
+        f"servo at {m['servo_max_acceleration_ratio']:.2f} of the acceleration and "
+        f"{m['servo_max_jerk_ratio']:.2f} of the jerk limits" in line
+    )
+    assert "twin:" not in line
 
 
 def test_a_servo_rate_that_does_not_divide_the_period_is_one_line(

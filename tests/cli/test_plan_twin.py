@@ -42,23 +42,33 @@ type = "mujoco"
 """
 
 
-def _plan(cli, tmp_path, stiffness: str):
+def _plan(cli, tmp_path, stiffness: str, *options: str):
     scene = tmp_path / "scene.toml"
     scene.write_text(SCENE.format(stiffness=stiffness))
     out = tmp_path / "run"
-    return cli("plan", scene, "--out", out, "--json"), out
+    return cli("plan", scene, "--out", out, *options), out
 
 
-def test_a_stiff_twin_steps_aside_with_the_plan(cli, tmp_path):
-    proc, _ = _plan(cli, tmp_path, "")
+def test_a_stiff_twin_steps_aside_with_the_plan_and_the_line_says_how_it_tracked(cli, tmp_path):
+    proc, out = _plan(cli, tmp_path, "")
     assert proc.returncode == 0, proc.stderr
-    m = json.loads(proc.stdout)["metrics"]
+    m = json.loads((out / "record.json").read_text())["metrics"]
     assert m["collisions"] == 0 and m["plant_contacts"] == 0
     assert m["plant_min_clearance"] > 0.005
+    line = " ".join(proc.stdout.split())  # rich wraps to the terminal width
+    assert f"max {1e3 * m['max_error']:.3f} mm" in line
+    assert (
+        f"servo at {m['servo_max_acceleration_ratio']:.2f} of the acceleration and "
+        f"{m['servo_max_jerk_ratio']:.2f} of the jerk limits" in line
+    )
+    assert (
+        f"twin: RMS error {1e3 * m['plant_rms_error']:.3f} mm, torque at "
+        f"{m['max_torque_ratio']:.2f} of the effort limits" in line
+    )
 
 
 def test_a_twin_too_soft_to_follow_is_hit_and_exits_4(cli, tmp_path):
-    proc, out = _plan(cli, tmp_path, "stiffness = 0.01")
+    proc, out = _plan(cli, tmp_path, "stiffness = 0.01", "--json")
     assert proc.returncode == 4, proc.stderr
     assert "twin" in proc.stderr and len(proc.stderr.splitlines()) == 1
     m = json.loads(proc.stdout)["metrics"]

@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from articula.errors import ConfigError
 from articula.geometry.poses import pose
@@ -37,6 +39,26 @@ def test_continuous_joint_has_no_position_limit_and_wraps_the_shortest_way(build
     a, b = np.array([0.0, -3.1, 0.0]), np.array([0.0, 3.1, 0.0])
     np.testing.assert_allclose(robot.difference(a, b), [0.0, 2 * math.pi - 6.2, 0.0])
     np.testing.assert_allclose(robot.difference(a, b)[[0, 2]], (a - b)[[0, 2]])
+
+
+def test_wrap_turns_a_continuous_joint_by_whole_turns_into_the_half_open_period(build_edited):
+    robot = build_edited(*CONTINUOUS_J2)
+    angles = st.floats(-1e3, 1e3, allow_nan=False) | st.sampled_from(
+        [math.pi, -math.pi, 3 * math.pi, math.nextafter(math.pi, 4), math.nextafter(-math.pi, -4)]
+    )
+
+    # No wall-clock limits: the machine is shared.
+    @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @given(st.lists(angles, min_size=3, max_size=3))
+    def wraps(values: list[float]) -> None:
+        q = np.array(values)
+        wrapped = robot.wrap(q)
+        assert -math.pi < wrapped[1] <= math.pi
+        turns = (q[1] - wrapped[1]) / (2 * math.pi)
+        assert abs(turns - round(turns)) < 1e-12 * max(1.0, abs(q[1]))
+        assert wrapped[[0, 2]].tolist() == q[[0, 2]].tolist()  # not continuous: untouched
+
+    wraps()
 
 
 def test_continuous_joint_without_limit_element_has_no_speed_limit(build_edited):

@@ -9,11 +9,13 @@ import signal
 
 import numpy as np
 import pytest
+import tomli_w
 import viser
 
 from articula.viewer.drawing import wxyz_position
 from articula.viewer.live import Live, LiveScene
 from articula.viewer.run_data import load_run
+from tests.arms import JACO2_HOME, arm_scene
 from tests.viewer.conftest import free_port, keep_screenshot, open_page, screenshot
 
 mujoco = pytest.importorskip(
@@ -60,6 +62,31 @@ def test_the_measured_arm_follows_the_commands_and_is_drawn_where_the_twin_has_i
     assert record["metrics"]["plant_min_clearance"] == min(live.recording.measured_clearance)
     assert 0 < record["metrics"]["max_torque_ratio"] <= 1
     assert len(load_run(tmp_path / "rec").t) == 150
+
+
+def test_a_jaco_at_its_unwrapped_home_drives_the_twin_as_from_the_wrapped_pose(server, tmp_path):
+    """Kinova's home reads 4.80 and 4.20 rad on the continuous joints 1 and 4: the twin starts
+    at the wrapped pose and follows the commands the short way, as from the pose written
+    wrapped."""
+    wrapped = [x - 2 * np.pi if j in (0, 3) else x for j, x in enumerate(JACO2_HOME)]
+    tools, robot = [], None
+    for k, q0 in enumerate((JACO2_HOME, wrapped)):
+        data = arm_scene("jaco2", duration=6.0)
+        data["robot"]["q0"] = q0
+        path = tmp_path / f"jaco{k}.toml"
+        path.write_text(tomli_w.dumps(data))
+        live = Live(server, LiveScene.load(path, "qp", plant="mujoco"))
+        for _ in range(200):
+            live.period()
+        robot = live.scene.robot
+        commanded, measured = np.array(live.recording.q), np.array(live.plant.arm.measured)
+        lag = robot.difference(measured, commanded)[:, robot.continuous]
+        assert np.max(np.abs(lag)) < 0.02  # [rad] the short way, never a turn behind
+        assert np.all(np.abs(measured[:, robot.continuous]) <= np.pi)  # handed back wrapped
+        tools.append(np.array([robot.ee_position(q) for q in measured]))
+        live.close()
+    assert robot.continuous.tolist() == [True, False, False, True, False, True]
+    np.testing.assert_allclose(tools[0], tools[1], atol=5e-5)  # [m]
 
 
 def test_an_unknown_plant_is_one_line_and_exit_2(scene_file, cli):

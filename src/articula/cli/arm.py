@@ -39,11 +39,12 @@ def plan(
 
     A motion with a colliding step (a link in an obstacle, or two links of a checked pair
     touching), or one the dynamics twin ([plant]) touches something in, still writes its run
-    folder, then exits with status 4; one that does not track its path (planner.tolerance)
-    writes it and exits with status 2, naming the cause measured (a stall at a boundary, a
-    start no step could leave, ...), as does a servo stream that passes below a clearance
-    floor, or a twin that holds a joint at its effort limit, passes below a floor or strays
-    from the path (docs/guides/servo.md).
+    folder, then exits with status 4; one that does not track its path (planner.tolerance,
+    max_error_tolerance) writes it and exits with status 2, naming the cause measured (a stall
+    at a boundary, a start no step could leave, ...), as does a servo stream that passes below
+    a clearance floor, or a twin that holds a joint at its effort limit, passes below a floor
+    or strays from the path (docs/guides/servo.md). The line printed gives the errors, the
+    clearance, and with a stream or a twin their key ratios.
 
     \b
     Example: articula plan src/articula/book/ch1/configs/circle_two_obstacles.toml --out runs/circle
@@ -64,22 +65,7 @@ def plan(
     if as_json:
         emit_json(record)
     else:
-        clearance = (
-            "no obstacles"
-            if m["min_clearance"] is None
-            else (f"min clearance {m['min_clearance']:.4f} m; collisions {int(m['collisions'])}")
-        )
-        speed = f"{m['time_per_iteration_us']:.1f} µs per iteration"
-        error = f"{1e3 * m['rms_error']:.3f} mm, max {1e3 * m['max_error']:.3f} mm"
-        settled = f"after {m['settle_s']:g} s"
-        if m.get("approach_s"):
-            settled = (
-                f"{m['settle_s']:g} s into the path (after a {m['approach_s']:.2g} s approach)"
-            )
-        stalled = f"; stalled {m['stalled_s']:.2f} s" if m.get("stalled_s") else ""
-        out.print(
-            f"RMS error {settled}: {error}; {clearance}{stalled}; {speed}; written to {out_dir}"
-        )
+        out.print(f"{_summary(m)}; written to {out_dir}")
     if not m.get("tracked", True):
         from articula.errors import InfeasibleError
 
@@ -109,3 +95,31 @@ def plan(
             f"periods (MuJoCo's contacts); the run folder {out_dir} is written; pass "
             "--allow-collisions to accept it, or raise planner.d_min or the plant's stiffness"
         )
+
+
+def _summary(m: dict) -> str:
+    """The run's line: errors, clearance, stall, the stream's and the twin's key ratios (those
+    the record has), the planner's time per iteration."""
+    settled = f"after {m['settle_s']:g} s"
+    if m.get("approach_s"):
+        settled = f"{m['settle_s']:g} s into the path (after a {m['approach_s']:.2g} s approach)"
+    parts = [
+        f"RMS error {settled}: {1e3 * m['rms_error']:.3f} mm, max {1e3 * m['max_error']:.3f} mm"
+    ]
+    if m["min_clearance"] is None:
+        parts.append("no obstacles")
+    else:
+        parts.append(f"min clearance {m['min_clearance']:.4f} m; collisions {int(m['collisions'])}")
+    if m.get("stalled_s"):
+        parts.append(f"stalled {m['stalled_s']:.2f} s")
+    if "servo_max_jerk_ratio" in m:
+        parts.append(
+            f"servo at {m['servo_max_acceleration_ratio']:.2f} of the acceleration and "
+            f"{m['servo_max_jerk_ratio']:.2f} of the jerk limits"
+        )
+    if "plant_rms_error" in m:
+        parts.append(
+            f"twin: RMS error {1e3 * m['plant_rms_error']:.3f} mm, torque at "
+            f"{m['max_torque_ratio']:.2f} of the effort limits"
+        )
+    return "; ".join([*parts, f"{m['time_per_iteration_us']:.1f} µs per iteration"])

@@ -99,7 +99,7 @@ def robot_table(robot: str) -> dict[str, Any]:
     """The [robot] table of --robot: a built-in name, a URDF file or a TOML file's [robot]
     table, paths made absolute."""
     from articula.errors import ConfigError
-    from articula.planning.config import absolute_paths
+    from articula.planning.config_files import absolute_paths
     from articula.validation import load_toml
 
     path = Path(robot)

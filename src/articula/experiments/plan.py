@@ -27,13 +27,8 @@ from articula.loops.servo import run_stream, ticks_per_period
 from articula.loops.stall import not_tracked_cause, stall_metrics
 from articula.loops.tracking import trace_columns, track, tracking_metrics
 from articula.planning.approach import Approach, approach
-from articula.planning.config import (
-    PlannerSpec,
-    TrajectorySpec,
-    absolute_paths,
-    make_planner,
-    make_targets,
-)
+from articula.planning.config import PlannerSpec, TrajectorySpec, make_planner, make_targets
+from articula.planning.config_files import absolute_paths
 from articula.planning.kept_limits import kept_limits
 from articula.planning.planner import Planner
 from articula.planning.reach import check_reach
@@ -155,7 +150,7 @@ class PlanSetup:
     Attributes:
         config: the validated config.
         scene: the robot, its obstacles and its checked link pairs.
-        q0: the start, shape (n,) [rad].
+        q0: the start, shape (n,) [rad], continuous joints wrapped to (−π, π].
         targets: the path's targets over its own time [s].
         reference: the targets over the run's time: the approach from the tool at q0 to the
             path's start (`planner.approach = "auto"`), then the path.
@@ -229,6 +224,9 @@ def build_plan(
     with named_by_file(where):
         scene, q0 = build_scene(config, base_dir)
         targets = make_targets(config.trajectory, base_dir)
+    # Every entry (the planner, the stream, the twin, live's arm) starts from this one pose: a
+    # continuous joint written 4.80 rad starts at −1.48, as the controller reads it.
+    q0 = scene.robot.wrap(q0)
     pose = scene.robot.ee_pose(q0)
     axis = pose[:3, :3] @ np.asarray(p.tool_axis, dtype=float)
     tool = Target(pose[:3, 3].copy(), pose[:3, :3].copy(), axis / np.linalg.norm(axis))
@@ -254,10 +252,10 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
             the path [m], clearances [m], collisions, limits, planner timings) and of
             loops.stall.stall_metrics (stalled_s [s], the stall's pair and clearance [m]),
             `tracked` (False when rms_error after `planner.settle` exceeds
-            `planner.tolerance`, or, for a pose or axis task, rms_orientation_error
-            `planner.orientation_tolerance`: the record's `not_tracked` then says why, with
-            the cause measured); with [servo], run_stream's metrics and the stream's
-            clearances at every sample (stream_min_clearance, ... of
+            `planner.tolerance`, max_error `planner.max_error_tolerance`, or, for a pose or
+            axis task, rms_orientation_error `planner.orientation_tolerance`: the record's
+            `not_tracked` then says why, with the cause measured); with [servo], run_stream's
+            metrics and the stream's clearances at every sample (stream_min_clearance, ... of
             loops.sampled_clearance), `tracked` False when they fall below a floor by more
             than STREAM_TOLERANCE; with [plant], TwinArm.metrics (plant_rms_error, ...,
             torque_saturated_s), `tracked` False on TwinArm.failure; and the trace columns of
@@ -309,14 +307,21 @@ def run_plan(config: PlanConfig, progress: Progress | None = None) -> Result:
 
 
 def _not_tracked(metrics: dict[str, Any], p: PlannerSpec, lead: float, periods: int) -> str | None:
-    """Why the run did not track (the error beyond planner.tolerance, or the orientation's
-    beyond planner.orientation_tolerance, and the cause measured), or None when it did."""
+    """Why the run did not track (the error beyond planner.tolerance or its largest beyond
+    planner.max_error_tolerance, or the orientation's beyond planner.orientation_tolerance, and
+    the cause measured), or None when it did."""
     after = f"{p.settle} s into the path" if lead else f"{p.settle} s"
     cause = not_tracked_cause(metrics, metrics["infeasible_steps"], periods)
-    if metrics["rms_error"] > p.tolerance:
+    rms, most = metrics["rms_error"], metrics["max_error"]
+    if rms > p.tolerance:
         return (
-            f"not tracked: rms error {metrics['rms_error']:.3g} m after {after} (max "
-            f"{metrics['max_error']:.3g} m) exceeds planner.tolerance = {p.tolerance} m: {cause}"
+            f"not tracked: rms error {rms:.3g} m after {after} (max {most:.3g} m) exceeds "
+            f"planner.tolerance = {p.tolerance} m: {cause}"
+        )
+    if most > p.max_error_tolerance:
+        return (
+            f"not tracked: max error {most:.3g} m after {after} (rms {rms:.3g} m) exceeds "
+            f"planner.max_error_tolerance = {p.max_error_tolerance} m: {cause}"
         )
     turned = metrics.get("rms_orientation_error")
     if turned is not None and turned > p.orientation_tolerance:

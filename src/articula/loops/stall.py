@@ -148,7 +148,7 @@ def not_tracked_cause(metrics: dict[str, Any], infeasible: float, periods: int) 
     stalled = metrics.get("stalled_s") or 0.0
     if metrics["max_error"] < STALL_ERROR:
         return (
-            f"the error stayed within {1e3 * metrics['max_error']:.3g} mm: planner.tolerance is "
+            f"the error stayed within {1e3 * metrics['max_error']:.3g} mm: the tolerance is "
             "tighter than the method tracks"
         )
     if stalled <= STALL_SHARE * (metrics.get("off_path_s") or 0.0):

@@ -10,6 +10,7 @@ __all__ = [
     "baornn_kernel",
     "clearance",
     "config",
+    "config_files",
     "newton_step",
     "objective",
     "planner",

@@ -252,7 +252,8 @@ class RobotModel:
         )
 
     def wrap(self, q: np.ndarray) -> np.ndarray:
-        """q with each continuous joint's value wrapped to (−π, π] (the others as they are).
+        """q with each continuous joint's value wrapped to (−π, π] (the others as they are):
+        the one function every joint value read from a file or an arm goes through.
 
         Args:
             q: joint positions, shape (..., nq) [rad or m].
@@ -260,7 +261,10 @@ class RobotModel:
         Returns:
             The wrapped joint positions, same shape [rad or m].
         """
-        return np.where(self.continuous, np.pi - np.mod(np.pi - q, 2 * np.pi), q)
+        wrapped = np.pi - np.mod(np.pi - q, 2 * np.pi)
+        # Just above π (π + 4e-16) the remainder rounds up to 2π: −π, which is π (kept) here.
+        wrapped = np.where(wrapped <= -np.pi, np.pi, wrapped)
+        return np.where(self.continuous, wrapped, q)
 
     def difference(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """a − b, the shortest way round for a continuous joint (in (−π, π]).

@@ -28,7 +28,8 @@ class TwinArm:
 
     Args:
         scene: the robot and its obstacles.
-        q0: where the arm starts, at rest, shape (n,) [rad].
+        q0: where the arm starts, at rest, shape (n,) [rad]; a continuous joint is started
+            wrapped to (−π, π], as the controller and the plan's stream start it.
         dt: the control period [s].
         rate: the servo rate [Hz], a whole number of ticks per period.
         gains: the joint servos' gains.
@@ -36,7 +37,8 @@ class TwinArm:
     Attributes:
         twin: the MuJoCo twin.
         stream: the servo stream its commands go through.
-        measured: the joints measured at the end of each period so far, one (n,) row each.
+        measured: the joints measured at the end of each period so far, one (n,) row each
+            (continuous joints wrapped to (−π, π], as the commands are).
         torque: the joint torques at the end of each period so far [N·m].
         contacts: the most contacts MuJoCo saw during each period so far (the tail's too).
         peak_torque: each joint's largest |torque| over every tick so far [N·m].
@@ -53,11 +55,14 @@ class TwinArm:
         rate: float,
         gains: ServoGains | None = None,
     ) -> None:
+        self._robot = scene.robot
+        q0 = self._robot.wrap(np.asarray(q0, dtype=float))
         self.twin = Twin(scene, rate, gains)
         self.twin.reset(q0)
         self.stream = ServoStream(ServoLimits.of(scene.robot), dt, rate)
         self.stream.reset(q0)
         self.joint_names = list(scene.robot.joint_names)
+        self._sent = q0  # the last set-point streamed (continuous joints unwrapped) [rad]
         self.measured: list[np.ndarray] = []
         self.torque: list[np.ndarray] = []
         self.contacts: list[int] = []
@@ -70,13 +75,20 @@ class TwinArm:
         """Play one period's command on the twin.
 
         Args:
-            command: the period's joint set-point, shape (n,) [rad].
+            command: the period's joint set-point, shape (n,) [rad]; a continuous joint is
+                streamed the shortest way round from the last set-point, as run_stream does.
 
         Returns:
-            The joints measured at the end of the period, shape (n,) [rad].
+            The joints measured at the end of the period, shape (n,) [rad] (continuous
+            joints wrapped to (−π, π]).
         """
-        self._play(command)
-        self.measured.append(self.twin.q)
+        robot = self._robot
+        # A command that wraps at ±π is the same pose: streamed as is, the servo would turn
+        # the joint a whole turn the long way.
+        turned = self._sent + robot.difference(command, self._sent)
+        self._sent = np.where(robot.continuous, turned, command)  # the others exactly as sent
+        self._play(self._sent)
+        self.measured.append(robot.wrap(self.twin.q))
         self.torque.append(self.twin.torque)
         return self.measured[-1]
 

@@ -33,7 +33,8 @@ class LivePlant:
     Attributes:
         arm: the twin and its servo stream (sim.twin_arm.TwinArm).
         scene: the twin's scene, its obstacles where the page last put them.
-        q: the joints measured at the end of the last period, shape (n,) [rad].
+        q: the joints measured at the end of the last period, shape (n,) [rad] (continuous
+            joints wrapped to (−π, π]).
         frames: the measured arm's link frames on the page, by link name.
     """
 
@@ -47,7 +48,7 @@ class LivePlant:
     ) -> None:
         self.scene, self._poses = with_live_obstacles(scene)
         self.arm: Any = twin_arm(config, self.scene, q0)
-        self.q = np.array(q0, dtype=float)
+        self.q = self.scene.robot.wrap(np.asarray(q0, dtype=float))
         self.frames, _ = drawing.add_robot(server, visuals, "/measured", MEASURED_COLOUR)
 
     def __call__(self, command: np.ndarray, poses: dict[str, np.ndarray]) -> np.ndarray:

@@ -12,7 +12,7 @@ import numpy as np
 from articula.errors import ArticulaError
 from articula.experiments.plan import PlanConfig, build_plan
 from articula.planning.approach import Approach
-from articula.planning.config import absolute_paths
+from articula.planning.config_files import absolute_paths
 from articula.scene.scene import Scene
 from articula.validation import load_toml
 
