@@ -1,4 +1,10 @@
-"""BAORNN (Algorithm 1): beetle-antennae search over joint angles, one time-step at a time."""
+"""BAORNN (Algorithm 1): beetle-antennae search over joint angles, one time-step at a time.
+
+Beyond the book, with acceleration limits both searches (this and baornn-improved) end each
+period where g descends from the search's point with the least acceleration
+(planning/smooth.py, `smoothing = "acceleration"`): the search's random steps land on the faces
+of the period's box, and an arm would be commanded its acceleration limits at ~20 Hz.
+"""
 
 from __future__ import annotations
 

@@ -70,6 +70,8 @@ class ImprovedParams(BaornnParams):
             (changes 1-5 alone) [-].
         slide_reach: how near its floor (d_min, self_d_min) a pair brings change 8's sliding
             step into play; 0: never [m].
+        smoothing: "acceleration": each period ends at the least-acceleration descent of g
+            from the search's point (planning/smooth.py); "none": at the search's point.
     """
 
     pairs: Annotated[int, Field(ge=1, le=64)] = 3
