@@ -37,7 +37,7 @@ def fold(method: str, self_collision: bool) -> tuple[float, float]:
 @pytest.mark.parametrize("method", ["baornn-improved", "qp"])
 def test_self_collision_stops_a_motion_that_folds_the_arm_into_itself(method):
     unchecked, _ = fold(method, self_collision=False)
-    assert unchecked < -0.005  # without the check the wrist goes through the base
+    assert unchecked < 0.0  # without the check the wrist goes into the base
     checked, error = fold(method, self_collision=True)
     assert checked > 0.0  # by the judge, coal, whatever GJK the planner used
     assert error < 0.02  # and the target is still reached, by another posture

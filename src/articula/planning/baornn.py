@@ -16,7 +16,7 @@ import numpy as np
 from pydantic import Field
 
 from articula.planning import baornn_kernel as kernel
-from articula.planning.clearance import EndEffector, RowSource
+from articula.planning.clearance import ClearanceRows, EndEffector, RowSource
 from articula.planning.newton_step import task_residual
 from articula.planning.objective import NO_STOP, Box, Objective, Stop
 from articula.planning.planner import WARM_UP_STEPS
@@ -77,6 +77,9 @@ class BeetleSearch:
     _box: Box | None = field(default=None, init=False, repr=False)  # this period's reach
     _stop: Stop = field(default=NO_STOP, init=False, repr=False)  # its braking check
     _rows: RowSource = field(init=False, repr=False)  # clearance rows and task Jacobian
+    # The last command and its motion: the smoothing shapes the commands, which a measured
+    # arm (follow) lags.
+    _sent: tuple[np.ndarray, np.ndarray] | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
         self._rows = RowSource(self.objective.scene, evaluation=self.objective.evaluation)
@@ -85,6 +88,7 @@ class BeetleSearch:
         """Forget the previous periods: the arm starts at rest."""
         if self.rate is not None:
             self.rate.reset()
+        self._sent = None
 
     def warm_up(self, q: np.ndarray, target: Target) -> None:
         """Compile (or load) the kernels of a step by taking WARM_UP_STEPS of them (the
@@ -163,7 +167,13 @@ class BeetleSearch:
         scale = rate.change
         if scale is None or not np.all(np.isfinite(scale) & (scale > 0)):
             return q, g
-        coast = start if rate.last_motion is None else start + rate.last_motion
+        # Coasting from the commands: the same as from the start and the last motion, unless
+        # the start is a measured arm's, which lags them.
+        if self._sent is None:
+            motion = np.zeros_like(start) if rate.last_motion is None else rate.last_motion
+            coast = start + motion
+        else:
+            coast, motion = self._sent[0] + self._sent[1], self._sent[1]
         floors = (obj.d_min, obj.self_d_min)
         reach = max(max(floors) + SLIDE_MARGIN + SMOOTH_BAND, PENALTY_REACH)
         end, rows = self._rows(q, t, reach)
@@ -171,13 +181,19 @@ class BeetleSearch:
         low, high = (bound - coast for bound in self._box)
         push = penalty_gradient(rows, obj.lambda_weight, obj.beta)
         change = smooth_change(
-            q - coast, coast - start, scale, A, residual, rows, floors, low, high, push
-        )
+            q - coast, motion, scale, A, residual, rows, floors, low, high, push,
+            self._error_cap(rows),
+        )  # fmt: skip
         self.evaluations += 1
         if change is None:
             return q, g
         # Refused (outside Ω, or braking from it would leave Ω): the search's point.
         return obj.project_and_value(coast + change, q, g, target, t, self._box, self._stop)
+
+    def _error_cap(self, rows: ClearanceRows) -> float:
+        """How far off the path the smoothing lets g's penalty trade the task for clearance
+        [m] (smooth_change's error_cap): as far as g does."""
+        return math.inf
 
     def _task_rows(self, end: EndEffector, target: Target) -> tuple[np.ndarray, np.ndarray]:
         """(A, r): the task's Jacobian rows [m/rad] and residual [m] at the end effector."""
@@ -194,6 +210,7 @@ class BeetleSearch:
             self.rate.record(q - start)
             if self.rate.strained or not math.isfinite(g):
                 self.infeasible += 1
+        self._sent = (q, q - (start if self._sent is None else self._sent[0]))
         return q
 
     @property

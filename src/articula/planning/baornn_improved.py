@@ -33,6 +33,9 @@
    the boundary only as points outside Ω; this step moves along it, the way the redundancy
    allows (issue 42, 100 grazing problems: 90 → 91 % on the iiwa14, 91 → 96 % on the
    Panda).
+With acceleration limits the period's end is then smoothed as BAORNN's (planning/smooth.py),
+change 5 kept there: while yield_distance clear, the smoothing's tracking term stiffens beyond
+TRADE_CAP off the path.
 """
 
 from __future__ import annotations
@@ -46,10 +49,14 @@ from pydantic import Field
 
 from articula.planning import baornn_kernel as kernel
 from articula.planning.baornn import BaornnParams, BeetleSearch
-from articula.planning.clearance import EndEffector
+from articula.planning.clearance import ClearanceRows, EndEffector
 from articula.planning.newton_step import newton_candidate, penalty_flat
 from articula.planning.slide import SLIDE_MARGIN, slide_correction
 from articula.planning.task import Target, as_target
+
+# Off the path by this much [m], the smoothing's tracking term is as steep as g's; farther, it
+# steepens, so that at least yield_distance clear the penalty trades little of the path.
+TRADE_CAP = 5e-4
 
 
 class ImprovedParams(BaornnParams):
@@ -294,6 +301,14 @@ class ImprovedBaornn(BeetleSearch):
         if g_s < g and obj.tracking_error(q_s, target) < error:
             return q_s, g_s
         return q, g
+
+    def _error_cap(self, rows: ClearanceRows) -> float:
+        """Change 5 in the smoothing: at least yield_distance clear, the penalty trades no
+        more than TRADE_CAP of the task for clearance [m]; closer, as g does."""
+        obstacle = rows.distance[~rows.self_pair]
+        if obstacle.size and obstacle.min() < self.params.yield_distance:
+            return math.inf
+        return TRADE_CAP
 
     def _newton(self, q: np.ndarray, target: Target, damping: float) -> np.ndarray:
         """The Gauss-Newton candidate from q [rad] (change 6), Pinocchio's Jacobian."""

@@ -76,10 +76,12 @@ def smooth_change(
     low: np.ndarray,
     high: np.ndarray,
     push: np.ndarray,
+    error_cap: float = np.inf,
 ) -> np.ndarray | None:
     """The period's change of motion Δ [rad] from coasting that descends g to first order from
     the search's point q_s with the least acceleration: with u = Δ/c, Δ' = Δ − Δ_s, it
-    minimises |r − JΔ'|² / (2 max(|r|, ERROR_FLOOR)) + ∇P·Δ' + ACCELERATION_COST·(½Σu_i² +
+    minimises |r − JΔ'|² / (2 min(max(|r|, ERROR_FLOOR), error_cap)) + ∇P·Δ' +
+    ACCELERATION_COST·(½Σu_i² +
     ½·DAMPING·|N(m/c + u)|²), N the projection onto the task's null space (in u), subject to
     ∇d_i·Δ' ≥ floor_i + SLIDE_MARGIN − d_i for every row within SMOOTH_BAND of its floor and
     low ≤ Δ ≤ high.
@@ -97,6 +99,9 @@ def smooth_change(
             shape (nq,) [rad].
         high: the largest, shape (nq,) [rad].
         push: ∇P, the penalty's gradient at q_s (penalty_gradient), shape (nq,) [m/rad].
+        error_cap: the error beyond which the tracking term stiffens, its slope |e| /
+            error_cap > 1: how far off the path the penalty may trade the task for clearance
+            (inf: as far as g trades it) [m].
 
     Returns:
         Δ, shape (nq,) [rad]; None when no change within [low, high] keeps the rows (to first
@@ -106,11 +111,11 @@ def smooth_change(
     M = task_jacobian * scale  # the task's rows per unit of each joint's limit
     wanted = residual + task_jacobian @ searched
     # The error where coasting ends, to first order: the search's own error is its noise.
-    fit = ACCELERATION_COST * max(float(np.linalg.norm(wanted)), ERROR_FLOOR)
+    fit = ACCELERATION_COST * min(max(float(np.linalg.norm(wanted)), ERROR_FLOOR), error_cap)
     free = np.eye(n) - np.linalg.pinv(M) @ M  # the redundancy, in u
     damp = DAMPING * free.T @ free
     H = M.T @ M / fit + np.eye(n) + damp
-    f = -M.T @ wanted / fit + (push * scale) / ACCELERATION_COST + damp @ (coasting / scale)
+    f = -M.T @ wanted / fit + push * scale / ACCELERATION_COST + damp @ (coasting / scale)
     floor = np.where(rows.self_pair, floors[1], floors[0]) + SLIDE_MARGIN
     near = rows.distance < floor + SMOOTH_BAND
     G = rows.gradient[near]
