@@ -29,6 +29,7 @@ from articula.planning.smooth import (
     smooth_change,
 )
 from articula.planning.task import Target, Task, as_target
+from articula.robots.model import RobotModel
 from articula.scene.scene import Scene
 from articula.validation import Positive, StrictModel
 
@@ -172,8 +173,9 @@ class BeetleSearch:
         if self._sent is None:
             motion = np.zeros_like(start) if rate.last_motion is None else rate.last_motion
             coast = start + motion
-        else:
-            coast, motion = self._sent[0] + self._sent[1], self._sent[1]
+        else:  # in the start's branch: a continuous joint's command may have been wrapped
+            motion = self._sent[1]
+            coast = self._sent[0] + _turns(obj.scene.robot, start - self._sent[0]) + motion
         floors = (obj.d_min, obj.self_d_min)
         reach = max(max(floors) + SLIDE_MARGIN + SMOOTH_BAND, PENALTY_REACH)
         end, rows = self._rows(q, t, reach)
@@ -210,7 +212,9 @@ class BeetleSearch:
             self.rate.record(q - start)
             if self.rate.strained or not math.isfinite(g):
                 self.infeasible += 1
-        self._sent = (q, q - (start if self._sent is None else self._sent[0]))
+        before = start if self._sent is None else self._sent[0]
+        motion = q - before
+        self._sent = (q, motion - _turns(self.objective.scene.robot, motion))
         return q
 
     @property
@@ -312,3 +316,8 @@ class Baornn(BeetleSearch):
         if g_new < g:  # Eqs. (1.21)-(1.22): accept only an improvement
             return q_new, g_new
         return q, g
+
+
+def _turns(robot: RobotModel, offset: np.ndarray) -> np.ndarray:
+    """The whole turns of a continuous joint in `offset` [rad] (exactly 0 elsewhere)."""
+    return np.where(robot.continuous, 2 * np.pi * np.round(offset / (2 * np.pi)), 0.0)

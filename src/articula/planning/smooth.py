@@ -25,14 +25,16 @@ import numpy as np
 from articula.planning.clearance import ClearanceRows
 from articula.planning.slide import SLIDE_MARGIN
 
-# How much of g a full change of motion on one joint costs [m]: the penalty's slope times the
-# joints' largest changes, over this, is the redundancy's push per period [-].
+# The acceleration cost's scale [m]: a full change of motion on one joint costs half this of
+# g; the penalty's slope times the joints' largest changes, over this, is the redundancy's
+# push per period [-].
 ACCELERATION_COST = 3e-5
 # g's tracking term |e| (Eq. 1.11) is weighed as |e_new|² / (2 max(|e|, ERROR_FLOOR)): equal
 # to |e| and of slope 1 where the search's point is, so that error is traded for clearance as
 # g trades it; on the path, of slope |e| / ERROR_FLOOR [m].
 ERROR_FLOOR = 1e-5
-# Share of the redundancy's velocity (the motion the task does not see) lost per period [-].
+# The damping of the redundancy's velocity (the motion the task does not see) [-]: unpushed,
+# a period keeps 1 / (1 + DAMPING) of it.
 DAMPING = 0.2
 # Rows within this much of their floor constrain the change [m] (the period's box moves a link
 # by a few mm at most).
@@ -80,7 +82,7 @@ def smooth_change(
 ) -> np.ndarray | None:
     """The period's change of motion Δ [rad] from coasting that descends g to first order from
     the search's point q_s with the least acceleration: with u = Δ/c, Δ' = Δ − Δ_s, it
-    minimises |r − JΔ'|² / (2 min(max(|r|, ERROR_FLOOR), error_cap)) + ∇P·Δ' +
+    minimises |r − JΔ'|² / (2 min(max(|r + JΔ_s|, ERROR_FLOOR), error_cap)) + ∇P·Δ' +
     ACCELERATION_COST·(½Σu_i² +
     ½·DAMPING·|N(m/c + u)|²), N the projection onto the task's null space (in u), subject to
     ∇d_i·Δ' ≥ floor_i + SLIDE_MARGIN − d_i for every row within SMOOTH_BAND of its floor and
