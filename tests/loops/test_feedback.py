@@ -105,3 +105,16 @@ def test_a_reset_forgets_the_last_target_and_its_lead():
     assert controller.target is None and not controller.lead.any()
     controller.step(ROBOT.ee_position(Q0), q_measured=Q0)  # no error against the old target
     assert not controller.lead.any()
+
+
+def test_an_arm_that_follows_its_commands_gets_no_lead_where_the_planner_leaves_the_path():
+    # The rock's centre as the target: the planner keeps the tool d_min off it, by choice. An
+    # arm measured exactly where it was sent does not lag, so nothing is to be made up for:
+    # integrating that chosen error (target − measured) wound the lead up against the planner.
+    controller = OnlineController.from_spec(SCENE, PlannerSpec(method="qp", dt=DT))
+    measured = controller.reset(Q0)
+    rock = SCENE.obstacles[0].pose_at(0.0)[:3, 3]
+    for _ in range(200):
+        measured = controller.step(rock, q_measured=measured)
+    assert np.linalg.norm(ROBOT.ee_position(measured) - rock) > 0.01  # kept off by choice
+    np.testing.assert_allclose(controller.lead, 0.0, atol=1e-12)

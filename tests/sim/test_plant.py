@@ -90,20 +90,13 @@ def twin_runs():
     return run
 
 
-# With Franka's published limits (robots/datasheets.py: 15 rad/s² and 7500 rad/s³ on joint 5,
-# where the URDF rule gave 10.4 and 1044), baornn-improved's start from rest asks the twin's
-# joint 5 for more than its 12 N·m for 0.13 s: the twin reports it and the run exits 2
-# (docs/deviations.md, "smooth commands").
-SATURATES = pytest.mark.xfail(strict=True, reason="the Panda's joint 5 saturates at the start")
-
-
 @pytest.mark.parametrize(
     ("scene", "method"),
     [
         ("circle", "qp"),
         ("panda", "qp"),
         ("circle", "baornn-improved"),
-        pytest.param("panda", "baornn-improved", marks=SATURATES),
+        ("panda", "baornn-improved"),
     ],
 )
 def test_the_twin_touches_nothing_within_its_effort_limits(twin_runs, scene, method):

@@ -84,7 +84,7 @@ class OnlineController:
         q_measured: the last measured joint positions (the start after reset), shape (n,)
             [rad]; None before reset.
         lead: how far [m] the targets are moved to make up for the measured tool's lag behind
-            them (its error integrated over LEAD_TIME), shape (3,).
+            the planner's tool (integrated over LEAD_TIME), shape (3,).
         held: the start's tool pose, whose orientation and axis fill in what a target lacks.
         target: the last period's target, completed.
     """
@@ -101,6 +101,7 @@ class OnlineController:
         self.q: np.ndarray | None = None
         self.q_measured: np.ndarray | None = None
         self.lead = np.zeros(3)
+        self._lead_given = np.zeros(3)  # the lead the last command was planned with
         self.held: Target | None = None  # the start's orientation and tool axis
         self.target: Target | None = None  # the last period's, complete
 
@@ -202,10 +203,11 @@ class OnlineController:
 
         The commands form one continuous stream within the speed and acceleration limits
         (what an arm's controller checks), each planned from the one before. With q_measured
-        the loop closes on the arm: the targets move ahead by the measured tool's error
-        integrated over LEAD_TIME (at most MAX_LEAD), so the measured tool converges to the
-        path while a servo that lags gets commands ahead of it (a plan from the measured joints
-        would hold a lagging servo back: docs/deviations.md).
+        the loop closes on the arm: the targets move ahead by the measured tool's lag behind
+        the planner's own tool for the target (the command's, less the lead) integrated over
+        LEAD_TIME (at most MAX_LEAD), so the measured tool converges to what the planner
+        chose while a servo that lags gets commands ahead of it (a plan from the measured
+        joints would hold a lagging servo back: docs/deviations.md).
 
         Args:
             target: a position (3,) [m], a pose (4×4, world) or a Target; an orientation or
@@ -236,12 +238,17 @@ class OnlineController:
                 raise ConfigError(f"obstacle_poses.{name}", str(exc)) from None
         if measured is not None:
             self.q_measured = measured
-            if self.target is not None:  # the last period's target, which the arm measured aims at
-                error = self.target.position - robot.ee_position(measured)
+            if self.target is not None:  # the arm measured aims at the last period's command
+                # Its lag behind the tool the planner chose for the last target (the command's
+                # less the lead it was given), not behind the target: a deviation the planner
+                # chose (clearance before the path, Eq. 1.11) integrated here winds the lead
+                # up against it, and the loop drifted off the path (docs/deviations.md).
+                intended = robot.ee_position(self.q) - self._lead_given
+                error = intended - robot.ee_position(measured)
                 lead = self.lead + self.dt / LEAD_TIME * error
                 self.lead = lead * min(1.0, MAX_LEAD / max(float(np.linalg.norm(lead)), 1e-12))
         self.target = self._complete(target)
-        led = self.target
+        led, self._lead_given = self.target, self.lead.copy()
         if self.lead.any():
             led = Target(self.target.position + self.lead, self.target.rotation, self.target.axis)
         self.q = robot.wrap(self.planner.step(self.q, led, self.t))

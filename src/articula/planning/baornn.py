@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from typing import Annotated, Literal
 
 import numpy as np
+import pinocchio as pin
 from pydantic import Field
 
 from articula.planning import baornn_kernel as kernel
@@ -25,8 +26,10 @@ from articula.planning.slide import SLIDE_MARGIN
 from articula.planning.smooth import (
     PENALTY_REACH,
     SMOOTH_BAND,
+    keep_off_gradient,
     penalty_gradient,
     smooth_change,
+    torque_rows,
 )
 from articula.planning.task import Target, Task, as_target
 from articula.robots.model import RobotModel
@@ -78,12 +81,14 @@ class BeetleSearch:
     _box: Box | None = field(default=None, init=False, repr=False)  # this period's reach
     _stop: Stop = field(default=NO_STOP, init=False, repr=False)  # its braking check
     _rows: RowSource = field(init=False, repr=False)  # clearance rows and task Jacobian
+    _dynamics: pin.Data = field(init=False, repr=False)  # scratch of the torque rows
     # The last command and its motion: the smoothing shapes the commands, which a measured
     # arm (follow) lags.
     _sent: tuple[np.ndarray, np.ndarray] | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
         self._rows = RowSource(self.objective.scene, evaluation=self.objective.evaluation)
+        self._dynamics = self.objective.scene.robot.model.createData()
 
     def reset(self) -> None:
         """Forget the previous periods: the arm starts at rest."""
@@ -181,10 +186,13 @@ class BeetleSearch:
         end, rows = self._rows(q, t, reach)
         A, residual = self._task_rows(end, target)
         low, high = (bound - coast for bound in self._box)
+        robot = obj.scene.robot
         push = penalty_gradient(rows, obj.lambda_weight, obj.beta)
+        keep_off = keep_off_gradient(q, (robot.lower, robot.upper), obj.lambda_weight, obj.beta)
         change = smooth_change(
             q - coast, motion, scale, A, residual, rows, floors, low, high, push,
-            self._error_cap(rows),
+            self._error_cap(rows), keep_off,
+            torque_rows(robot.model, self._dynamics, coast - motion, motion / rate.dt, rate.dt),
         )  # fmt: skip
         self.evaluations += 1
         if change is None:

@@ -9,9 +9,12 @@ change of motion Δ (from coasting: the start plus the last period's motion) tha
 - meets the task from the search's point to first order (the search's point is where the
   task and the clearance rows are linearised);
 - keeps every near pair above its floor to first order, and stays in the period's box;
-- moves the redundancy down the gradient of g's penalty (Eqs. 1.11, 1.14) at a rate set by
-  PENALTY_SCALE, its velocity damped by DAMPING per period: a smooth, deterministic descent
-  of the penalty the search descends by random antennae;
+- moves the redundancy down the gradient of g's penalty (Eqs. 1.11, 1.14), its velocity
+  damped by DAMPING per period: a smooth, deterministic descent of the penalty the search
+  descends by random antennae; beyond g, the redundancy alone (the task's null space) also
+  moves the joints off their limits (keep_off_gradient): without it the arm drifted into a
+  posture with a joint at its limit and a link pair at self_d_min, and stayed there while the
+  path moved away (the book's circle, iiwa14, baornn-improved: 27 mm RMS);
 - within those, uses the least of each joint's acceleration limit.
 The result is projected onto Ω with the braking check like any candidate, and the search's
 own point is kept when it is refused.
@@ -21,6 +24,7 @@ from __future__ import annotations
 
 import daqp
 import numpy as np
+import pinocchio as pin
 
 from articula.planning.clearance import ClearanceRows
 from articula.planning.slide import SLIDE_MARGIN
@@ -44,6 +48,17 @@ PENALTY_REACH = 0.25
 # The penalty's nearest distance (Eq. 1.14) as a soft minimum of this width over the rows [m],
 # so that two obstacles at nearly the same distance do not switch the push every period.
 SOFT_MIN = 0.005
+# The share of each joint's effort limit a smoothed change may ask for in rigid-body torque
+# (gravity included) [-]: the rest is the arm's servo's, to correct its errors with.
+TORQUE_SHARE = 0.7
+# A joint within LIMIT_REACH of a limit [rad] is pushed off it as a link is from an obstacle
+# LIMIT_LEVER times as far [m/rad] (a link about this far from the joint's axis).
+LIMIT_REACH = 0.5
+LIMIT_LEVER = 0.1
+# The keep-off asks at most this share of a joint's acceleration limit [-]: near a limit its
+# slope is unbounded, and a redundancy driven at the limits leaves the path (to second order).
+# (g's own push is not capped: the clearance it keeps fell to 2.1 mm of d_min = 2 mm.)
+KEEP_OFF_SHARE = 0.5
 
 
 def penalty_gradient(rows: ClearanceRows, lambda_weight: float, beta: float) -> np.ndarray:
@@ -67,6 +82,68 @@ def penalty_gradient(rows: ClearanceRows, lambda_weight: float, beta: float) -> 
     return -lambda_weight * beta / near ** (beta + 1) * (w @ gradient) / w.sum()
 
 
+def keep_off_gradient(
+    q: np.ndarray, limits: tuple[np.ndarray, np.ndarray], lambda_weight: float, beta: float
+) -> np.ndarray:
+    """Beyond the book: the gradient of Σ Λ/(s_i + SLIDE_MARGIN)^β over the joints within
+    LIMIT_REACH of a limit, s_i = LIMIT_LEVER times the joint's distance to it, each less its
+    slope at the reach so that it grows from 0: what keeps the redundancy off the joint limits,
+    which g does not see.
+
+    Args:
+        q: the joint angles, shape (nq,) [rad].
+        limits: the joints' lower and upper position limits, each shape (nq,) [rad] (±inf:
+            none, as for a continuous joint).
+        lambda_weight: Λ [m^(1+β)]; 0: none, as g's penalty.
+        beta: β.
+
+    Returns:
+        The gradient, shape (nq,) [m/rad].
+    """
+    room = np.minimum(q - limits[0], limits[1] - q)
+    away = np.where(q - limits[0] < limits[1] - q, 1.0, -1.0)  # off the nearer limit
+    slope = _barrier_slope(LIMIT_LEVER * room, LIMIT_LEVER * LIMIT_REACH, lambda_weight, beta)
+    return -LIMIT_LEVER * slope * away
+
+
+def _barrier_slope(s: np.ndarray, reach: float, lambda_weight: float, beta: float) -> np.ndarray:
+    """d/ds of −Λ/(s + SLIDE_MARGIN)^β less its value at `reach`, 0 beyond it [-]."""
+
+    def slope(x: np.ndarray | float) -> np.ndarray:
+        return lambda_weight * beta / (np.maximum(x, 0.0) + SLIDE_MARGIN) ** (beta + 1)
+
+    return np.where(s < reach, slope(s) - slope(reach), 0.0)
+
+
+def torque_rows(
+    model: pin.Model, data: pin.Data, q: np.ndarray, velocity: np.ndarray, dt: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The joint torques a period's change of motion Δ asks for, τ = M(q)·Δ/dt² + h(q, q̇)
+    (the URDF's inertias; Pinocchio's CRBA and RNEA), as rows kept within ±TORQUE_SHARE of
+    the effort limits (beyond the book: a change within the acceleration limits of the
+    datasheet may still need more torque than the arm has).
+
+    Args:
+        model: the arm's Pinocchio model (its inertias and effort limits).
+        data: a Pinocchio data of it, used as scratch.
+        q: the joint angles at the period's end, shape (nq,) [rad].
+        velocity: the joint velocities there, shape (nq,) [rad/s].
+        dt: the control period [s].
+
+    Returns:
+        (A [N·m/rad], low, high [N·m]) with low ≤ A·Δ ≤ high; None where the URDF states no
+        inertia or no effort limit (nothing to keep).
+    """
+    effort = TORQUE_SHARE * np.asarray(model.effortLimit, dtype=float)
+    if sum(inertia.mass for inertia in model.inertias) == 0 or not np.any(np.isfinite(effort)):
+        return None
+    inertia = pin.crba(model, data, q)
+    inertia = np.triu(inertia) + np.triu(inertia, 1).T  # CRBA fills the upper triangle
+    bias = pin.rnea(model, data, q, velocity, np.zeros_like(q))
+    effort = np.where(np.isfinite(effort), effort, 1e30)
+    return inertia / dt**2, -effort - bias, effort - bias
+
+
 def smooth_change(
     searched: np.ndarray,
     coasting: np.ndarray,
@@ -79,12 +156,14 @@ def smooth_change(
     high: np.ndarray,
     push: np.ndarray,
     error_cap: float = np.inf,
+    keep_off: np.ndarray | None = None,
+    torque: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray | None:
     """The period's change of motion Δ [rad] from coasting that descends g to first order from
     the search's point q_s with the least acceleration: with u = Δ/c, Δ' = Δ − Δ_s, it
-    minimises |r − JΔ'|² / (2 min(max(|r + JΔ_s|, ERROR_FLOOR), error_cap)) + ∇P·Δ' +
-    ACCELERATION_COST·(½Σu_i² +
-    ½·DAMPING·|N(m/c + u)|²), N the projection onto the task's null space (in u), subject to
+    minimises |r − JΔ'|² / (2 min(max(|r + JΔ_s|, ERROR_FLOOR), error_cap)) + ∇P·Δ' + K·Δ_N
+    + ACCELERATION_COST·(½Σu_i² + ½·DAMPING·|N(m/c + u)|²), N the projection onto the task's
+    null space (in u), Δ_N = c·N(u − u_s) the change's part there, subject to
     ∇d_i·Δ' ≥ floor_i + SLIDE_MARGIN − d_i for every row within SMOOTH_BAND of its floor and
     low ≤ Δ ≤ high.
 
@@ -104,6 +183,10 @@ def smooth_change(
         error_cap: the error beyond which the tracking term stiffens, its slope |e| /
             error_cap > 1: how far off the path the penalty may trade the task for clearance
             (inf: as far as g trades it) [m].
+        keep_off: a gradient descended through the task's null space only (linear, as ∇P)
+            (keep_off_gradient), shape (nq,) [m/rad]; None: none.
+        torque: rows (A, low, high) kept as low ≤ A·Δ ≤ high (torque_rows) [N·m]; None:
+            none.
 
     Returns:
         Δ, shape (nq,) [rad]; None when no change within [low, high] keeps the rows (to first
@@ -118,13 +201,20 @@ def smooth_change(
     damp = DAMPING * free.T @ free
     H = M.T @ M / fit + np.eye(n) + damp
     f = -M.T @ wanted / fit + push * scale / ACCELERATION_COST + damp @ (coasting / scale)
+    if keep_off is not None:  # through the redundancy only: never traded for the task
+        nudge = free @ (keep_off * scale) / ACCELERATION_COST
+        f += nudge * min(1.0, KEEP_OFF_SHARE / max(float(np.abs(nudge).max()), 1e-300))
     floor = np.where(rows.self_pair, floors[1], floors[0]) + SLIDE_MARGIN
     near = rows.distance < floor + SMOOTH_BAND
     G = rows.gradient[near]
     need = floor[near] - rows.distance[near] + G @ searched
-    A = np.ascontiguousarray(G * scale)
+    A = G * scale
     upper = np.concatenate([high / scale, np.full(need.size, 1e30)])
     lower = np.concatenate([low / scale, need])
+    if torque is not None:
+        A = np.vstack([A, torque[0] * scale])
+        lower, upper = np.concatenate([lower, torque[1]]), np.concatenate([upper, torque[2]])
+    A = np.ascontiguousarray(A)
     sense = np.zeros(upper.size, dtype=np.intc)
     u, _, status, _ = daqp.solve(H, f, A, upper, lower, sense)
     if status <= 0:
