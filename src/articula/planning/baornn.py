@@ -188,7 +188,9 @@ class BeetleSearch:
         low, high = (bound - coast for bound in self._box)
         robot = obj.scene.robot
         push = penalty_gradient(rows, obj.lambda_weight, obj.beta)
-        keep_off = keep_off_gradient(q, (robot.lower, robot.upper), obj.lambda_weight, obj.beta)
+        keep_off = keep_off_gradient(
+            q, (robot.lower, robot.upper), rows, obj.self_d_min, obj.lambda_weight, obj.beta
+        )
         change = smooth_change(
             q - coast, motion, scale, A, residual, rows, floors, low, high, push,
             self._error_cap(rows), keep_off,

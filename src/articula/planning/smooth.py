@@ -8,13 +8,16 @@ redundancy's motion is the noise of a random search. Here the period ends instea
 change of motion Δ (from coasting: the start plus the last period's motion) that
 - meets the task from the search's point to first order (the search's point is where the
   task and the clearance rows are linearised);
-- keeps every near pair above its floor to first order, and stays in the period's box;
+- keeps every near pair above its floor to first order, stays in the period's box, and asks
+  for joint torques within TORQUE_SHARE of the efforts (torque_rows, where the URDF states
+  inertias);
 - moves the redundancy down the gradient of g's penalty (Eqs. 1.11, 1.14), its velocity
   damped by DAMPING per period: a smooth, deterministic descent of the penalty the search
   descends by random antennae; beyond g, the redundancy alone (the task's null space) also
-  moves the joints off their limits (keep_off_gradient): without it the arm drifted into a
-  posture with a joint at its limit and a link pair at self_d_min, and stayed there while the
-  path moved away (the book's circle, iiwa14, baornn-improved: 27 mm RMS);
+  moves the joints off their limits and link pairs off self_d_min (keep_off_gradient):
+  without it the arm drifted into a posture with a joint at its limit and a link pair at
+  self_d_min, and stayed there while the path moved away (the book's circle, iiwa14,
+  baornn-improved: up to 29 mm RMS);
 - within those, uses the least of each joint's acceleration limit.
 The result is projected onto Ω with the braking check like any candidate, and the search's
 own point is kept when it is refused.
@@ -55,6 +58,12 @@ TORQUE_SHARE = 0.7
 # LIMIT_LEVER times as far [m/rad] (a link about this far from the joint's axis).
 LIMIT_REACH = 0.5
 LIMIT_LEVER = 0.1
+# Link pairs within SELF_REACH of self_d_min [m] are kept off it too, where the joints move
+# them apart at least PAIR_STEER [m/rad]: a pair at a nearly constant distance (the UR10's
+# wrist links) has a gradient that is its nearest points' noise, its sign flipping from one
+# period to the next (±0.004 m/rad), which drove 43 % of the UR10's periods to the limits.
+SELF_REACH = 0.02
+PAIR_STEER = 0.02
 # The keep-off asks at most this share of a joint's acceleration limit [-]: near a limit its
 # slope is unbounded, and a redundancy driven at the limits leaves the path (to second order).
 # (g's own push is not capped: the clearance it keeps fell to 2.1 mm of d_min = 2 mm.)
@@ -83,17 +92,25 @@ def penalty_gradient(rows: ClearanceRows, lambda_weight: float, beta: float) -> 
 
 
 def keep_off_gradient(
-    q: np.ndarray, limits: tuple[np.ndarray, np.ndarray], lambda_weight: float, beta: float
+    q: np.ndarray,
+    limits: tuple[np.ndarray, np.ndarray],
+    rows: ClearanceRows,
+    self_d_min: float,
+    lambda_weight: float,
+    beta: float,
 ) -> np.ndarray:
     """Beyond the book: the gradient of Σ Λ/(s_i + SLIDE_MARGIN)^β over the joints within
-    LIMIT_REACH of a limit, s_i = LIMIT_LEVER times the joint's distance to it, each less its
-    slope at the reach so that it grows from 0: what keeps the redundancy off the joint limits,
-    which g does not see.
+    LIMIT_REACH of a limit (s_i = LIMIT_LEVER times the joint's distance to it) and the link
+    pairs within SELF_REACH of self_d_min that the joints move apart at least PAIR_STEER fast
+    (s_i = the pair's distance above the floor), each less its slope at the reach so that it
+    grows from 0: what keeps the redundancy off the floors g does not see.
 
     Args:
         q: the joint angles, shape (nq,) [rad].
         limits: the joints' lower and upper position limits, each shape (nq,) [rad] (±inf:
             none, as for a continuous joint).
+        rows: the clearance rows at q (its link pairs are used).
+        self_d_min: the link pairs' floor [m].
         lambda_weight: Λ [m^(1+β)]; 0: none, as g's penalty.
         beta: β.
 
@@ -103,7 +120,10 @@ def keep_off_gradient(
     room = np.minimum(q - limits[0], limits[1] - q)
     away = np.where(q - limits[0] < limits[1] - q, 1.0, -1.0)  # off the nearer limit
     slope = _barrier_slope(LIMIT_LEVER * room, LIMIT_LEVER * LIMIT_REACH, lambda_weight, beta)
-    return -LIMIT_LEVER * slope * away
+    steered = np.linalg.norm(rows.gradient, axis=1) >= PAIR_STEER
+    pairs = rows.self_pair & steered & (rows.distance < self_d_min + SELF_REACH)
+    pair_slope = _barrier_slope(rows.distance[pairs] - self_d_min, SELF_REACH, lambda_weight, beta)
+    return -LIMIT_LEVER * slope * away - pair_slope @ rows.gradient[pairs]
 
 
 def _barrier_slope(s: np.ndarray, reach: float, lambda_weight: float, beta: float) -> np.ndarray:
