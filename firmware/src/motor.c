@@ -170,7 +170,7 @@ static void step(uint16_t code, int32_t count) {
     put_raw(values + 6, duty2);
     rig_sample();
     if (++n >= steps) {
-        ATOMIC_BLOCK(ATOMIC_RESTORESTATE) { safe(); } /* the last step: outputs off now */
+        safe(); /* the last step: outputs off now */
         rig_done();
     }
 }
@@ -279,18 +279,21 @@ static uint8_t start(float duration, const char **why) {
 }
 
 /* Both H-bridges off: no more control ticks or samples, the enables taken off the PWM and
- * driven low (a fast PWM at duty 0 still pulses once a cycle), the direction pins low. */
+ * driven low (a fast PWM at duty 0 still pulses once a cycle), the direction pins low; in one
+ * atomic write of some 50 cycles (tools/interrupts_off.py). */
 static void safe(void) {
-    TIMSK1 = 0;
-    ADCSRA = (uint8_t)((ADCSRA & ~_BV(ADIE)) | _BV(ADIF)); /* ADIF: cleared by a 1 */
-    live = 0;
-    TCCR3A &= (uint8_t)~_BV(COM3A1);
-    TCCR4A &= (uint8_t)~_BV(COM4A1);
-    OCR3AL = 0;
-    OCR4AL = 0;
-    PORTE &= (uint8_t)~_BV(PE3);
-    PORTH &= (uint8_t)~_BV(PH3);
-    PORTA &= (uint8_t)~(_BV(PA2) | _BV(PA3) | _BV(PA4) | _BV(PA5));
+    ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+        TIMSK1 = 0;
+        ADCSRA = (uint8_t)((ADCSRA & ~_BV(ADIE)) | _BV(ADIF)); /* ADIF: cleared by a 1 */
+        live = 0;
+        TCCR3A &= (uint8_t)~_BV(COM3A1);
+        TCCR4A &= (uint8_t)~_BV(COM4A1);
+        PORTE &= (uint8_t)~_BV(PE3);
+        PORTH &= (uint8_t)~_BV(PH3);
+        PORTA &= (uint8_t)~(_BV(PA2) | _BV(PA3) | _BV(PA4) | _BV(PA5));
+        OCR3AL = 0;
+        OCR4AL = 0;
+    }
 }
 
 /* GET: the gains and the reference as SET_GAINS and SET_REFERENCE carry them. */

@@ -121,7 +121,7 @@ static void step(uint16_t code) {
     sample[0] = reference, sample[1] = angle, sample[2] = count;
     rig_sample();
     if (++n >= steps) {
-        ATOMIC_BLOCK(ATOMIC_RESTORESTATE) { safe(); } /* the last step: valve and pump off */
+        safe(); /* the last step: valve and pump off */
         rig_done();
     }
 }
@@ -222,16 +222,19 @@ static uint8_t start(float duration, const char **why) {
 }
 
 /* Valve closed, pump off: no more control ticks or samples, the valve's pin taken off the PWM
- * and driven low (a fast PWM at duty 0 still pulses once a period). An open-loop output
- * (SET_OUTPUT) holds for one run only. */
+ * and driven low (a fast PWM at duty 0 still pulses once a period); in one atomic write of
+ * some 40 cycles (tools/interrupts_off.py). An open-loop output (SET_OUTPUT) holds for one
+ * run only. */
 static void safe(void) {
-    TIMSK1 = 0;
-    ADCSRA = (uint8_t)((ADCSRA & ~_BV(ADIE)) | _BV(ADIF)); /* ADIF: cleared by a 1 */
-    live = 0;
-    TCCR1A &= (uint8_t)~_BV(COM1A1);
-    OCR1A = 0;
-    PORTB &= (uint8_t)~_BV(PB5);
-    PORTH &= (uint8_t)~_BV(PH5);
+    ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+        TIMSK1 = 0;
+        ADCSRA = (uint8_t)((ADCSRA & ~_BV(ADIE)) | _BV(ADIF)); /* ADIF: cleared by a 1 */
+        live = 0;
+        TCCR1A &= (uint8_t)~_BV(COM1A1);
+        PORTB &= (uint8_t)~_BV(PB5);
+        PORTH &= (uint8_t)~_BV(PH5);
+        OCR1A = 0;
+    }
     open_loop = -1.0f;
 }
 
