@@ -70,6 +70,7 @@ static volatile uint32_t tick;
 static uint32_t samples_left;
 static uint16_t frame_ms; /* when the sensor's last frame was taken (rig_clock_ms) */
 static struct coils venting;
+static volatile uint8_t live; /* the run's valves may be driven (safe() ends that) */
 
 /* The sensor's frames, filled by the Serial1 interrupt in turn: the one ready for the main
  * loop is not written until it has been taken (no copy in the interrupt). */
@@ -92,18 +93,25 @@ static void add_coils(struct coils *to, uint8_t chamber, uint8_t mode) {
 }
 
 /* Coils set: a read-modify-write of each port (the caller keeps interrupts out), some 20
- * cycles. Inlined: a call from the tick's interrupt would make it save every register a call
- * may clobber, some 40 cycles more with interrupts off. */
-static inline __attribute__((always_inline)) void apply(const struct coils *c) {
+ * cycles. */
+static void apply(const struct coils *c) {
     PORTA = (uint8_t)((PORTA & ~c->mask_a) | c->bits_a);
     PORTC = (uint8_t)((PORTC & ~c->mask_c) | c->bits_c);
 }
 
-/* The 10 kHz tick: the event that is due, its coils precomputed at START. */
-ISR(TIMER1_COMPA_vect) {
+/* The 10 kHz tick: the event that is due, its coils precomputed at START. With interrupts on
+ * from its first instruction (ISR_NOBLOCK: the 32-bit tick's prologue alone is some 60
+ * cycles), the coils set atomically and only while the run is live: the watchdog's safe(),
+ * nested in it, is not undone. */
+ISR(TIMER1_COMPA_vect, ISR_NOBLOCK) {
     probe_busy();
     uint32_t now = ++tick;
-    if (next_event < event_count && events[next_event].tick <= now) apply(&events[next_event++].coils);
+    if (next_event < event_count && events[next_event].tick <= now) {
+        ATOMIC_BLOCK(ATOMIC_FORCEON) {
+            if (live) apply(&events[next_event].coils);
+        }
+        next_event++;
+    }
     probe_idle();
 }
 
@@ -222,6 +230,7 @@ static uint8_t start(float duration, const char **why) {
     add_coils(&first, chamber, FILL);
     ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
         apply(&first);
+        live = 1;
         frame_ready = 0;
         tick = 0;
         PORTH |= _BV(PH5); /* the pump */
@@ -238,6 +247,7 @@ static void safe(void) {
     ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
         TIMSK1 = 0;
         TIFR1 = _BV(OCF1A);
+        live = 0;
         PORTH &= (uint8_t)~_BV(PH5);
         apply(&venting);
     }
