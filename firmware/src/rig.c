@@ -290,20 +290,26 @@ static uint8_t send_sample(void) {
     return 1;
 }
 
-/* The bytes that came, up to the end of one command, RECEIVE_BATCH at most (the control step
- * goes first), and only with room for a reply: the main loop never waits on the line during a
- * run. One byte at a time, so that a pass's own cost is spread over many bytes: at full line
- * rate the receive interrupt takes about half of each byte's 160 cycles. How many it took. */
+/* The bytes that came, in batches shorter than any frame (7 bytes), so that one ends in a
+ * batch at most; until a command has been answered or RECEIVE_BATCH bytes taken (the control
+ * step goes first), and only with room for a reply (the main loop never waits on the line
+ * during a run). Several batches a pass, so that a pass's own cost is spread over many bytes:
+ * at full line rate the receive interrupt takes half of each byte's 160 cycles. How many it
+ * took. */
 static uint8_t receive(void) {
     if (uart_space() < REPLY_ROOM) return 0;
     struct command command;
-    uint8_t byte, took = 0;
-    while (took < RECEIVE_BATCH && uart_take(&byte, 1)) {
-        took++;
-        if (frame_receive(byte, &command)) {
-            heard_ms = rig_clock_ms();
-            handle(&command); /* its reply fits: the room was there */
-            break;
+    uint8_t bytes[6], took = 0, answered = 0;
+    while (!answered && took < RECEIVE_BATCH) {
+        uint8_t n = uart_take(bytes, sizeof bytes);
+        if (!n) break;
+        took = (uint8_t)(took + n);
+        for (uint8_t k = 0; k < n; k++) {
+            if (frame_receive(bytes[k], &command)) {
+                heard_ms = rig_clock_ms();
+                handle(&command); /* its reply fits: the room was there */
+                answered = 1;
+            }
         }
     }
     return took;

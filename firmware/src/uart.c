@@ -26,8 +26,9 @@ static volatile uint8_t served_at;
  * the shift register, kept too, is matched by the one on the line, counted in `held`). The
  * chip says only "one or more" (DOR0); this is within a byte of the harness's exact count
  * when the bytes came back to back since the last one read (a burst behind a command), more
- * when the line was idle before them, and at least 1. */
-static uint8_t overrun_bytes(uint8_t held) {
+ * when the line was idle before them, and at least 1. Inlined: a call from the receive
+ * interrupt would make it save every register a call may clobber. */
+static inline __attribute__((always_inline)) uint8_t overrun_bytes(uint8_t held) {
     uint8_t carried = (uint8_t)(((uint16_t)held * 103) >> 8); /* held · 4 / 10, no division */
     return carried > KEPT ? (uint8_t)(carried - KEPT) : 1;
 }
