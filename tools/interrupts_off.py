@@ -110,7 +110,7 @@ class Program:
     """
 
     def __init__(self, elf: Path) -> None:
-        listing = subprocess.run(["avr-objdump", "-d", str(elf)], capture_output=True,
+        listing = subprocess.run(["avr-objdump", "-d", "-z", str(elf)], capture_output=True,
                                  text=True, check=True).stdout  # fmt: skip
         self.code: dict[int, Instruction] = {}
         self.functions: dict[int, str] = {}

@@ -27,7 +27,7 @@ from articula.errors import DeviceError
 from articula.rigs.firmware import FirmwareRig
 from articula.rigs.link import DeviceResetError, Link
 from articula.rigs.pin_trace import CPU_HZ, PinTrace, active_outputs
-from articula.rigs.protocol import Kind, ResetCause
+from articula.rigs.protocol import Kind, ResetCause, RigKind
 from articula.rigs.run import run_program
 
 LONG_RUN_S = 30.0  # [s] a run that only a STOP, the host's silence or a hang ends
@@ -271,6 +271,26 @@ def _filler() -> bytes:
     """FILL_S of the line at 1 Mbaud that the device drops unanswered: one overlong frame
     (its delimiter last), so it keeps the line busy without filling the send queue."""
     return b"\x55" * round(FILL_S / BYTE_S - 1) + b"\0"
+
+
+def short_run(link: Link) -> float:
+    """A run that ends by itself a few periods in, for `burst_trial`'s "done": its duration;
+    on the six-chamber rig, whose run must outlast the actuation's hold, the hold set to two
+    periods first.
+
+    Args:
+        link: the line to the rig.
+
+    Returns:
+        The run's duration [s].
+    """
+    period = link.info.sample_period_us * 1e-6
+    if link.info.rig != RigKind.SIX_CHAMBER:
+        return 3 * period
+    reference = bytearray(link.setting(Kind.SET_REFERENCE))
+    reference[10:14] = struct.pack("<f", 2 * period)  # hold [s] (docs/protocol.md)
+    link.command(Kind.SET_REFERENCE, bytes(reference))
+    return 5 * period
 
 
 def burst_trial(
