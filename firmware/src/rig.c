@@ -60,9 +60,9 @@ ISR(TIMER0_COMPA_vect) { clock_ms++; }
 /* The watchdog's first timeout (interrupt and reset mode): the main loop has not come round
  * for 32 ms, hung or late. Outputs off now; the chip resets at the next timeout unless the
  * main loop comes back, sees `stalled`, ends the run and arms the interrupt again. Interrupts
- * on from its first instruction (safe() makes its own short atomic writes), so that it holds
- * no byte of the host's up. A main loop hung with interrupts off gets no such interrupt:
- * only the reset at the second timeout. */
+ * on from its first instruction (safe() makes its own short atomic writes), so that its
+ * prologue does not hold the host's bytes up. A main loop hung with interrupts off gets no
+ * such interrupt: only the reset at the second timeout. */
 ISR(WDT_vect, ISR_NOBLOCK) {
     if (rig) rig->safe();
     stalled = 1;

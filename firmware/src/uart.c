@@ -34,8 +34,9 @@ static inline __attribute__((always_inline)) uint8_t overrun_bytes(uint8_t held)
 }
 
 /* A byte came: into the queue, and the losses counted in bytes (the status first: DOR
- * belongs to the byte in UDR0 and is gone once it is read). About 50 cycles: every other
- * interrupt and every section with interrupts off is kept under the 160 cycles of a byte. */
+ * belongs to the byte in UDR0 and is gone once it is read). About 80 cycles, 110 at most
+ * (tools/interrupts_off.py): every section with interrupts off is kept under the 160 cycles
+ * of a byte. */
 ISR(USART0_RX_vect) {
     uint8_t status = UCSR0A, now = TCNT5L;
     uint8_t byte = UDR0, head = rx_head;
