@@ -179,7 +179,7 @@ def safety(folder: Path, cycles: list[int], latency: list[int]) -> dict[str, Any
                 m["rx_overruns"] += traffic_trial(rig, trace, link, BURSTS[name])
                 run_s = short_run(link)
                 events = [e for e, count in BURST_TRIALS.items() for _ in range(count)]
-                bursts = [burst_trial(rig, trace, link, event, run_s) for event in events]
+                bursts = [burst_trial(trace, link, event, run_s) for event in events]
                 m["burst_after_stop_lost_bytes"][name] = sum(t.lost_bytes for t in bursts)
                 m["burst_trials"][name] = len(bursts)
                 m["burst_done_covered"][name] = sum(t.covered for t in bursts if t.event == "done")

@@ -118,13 +118,13 @@ def test_commands_in_bursts_during_a_run_lose_no_byte(traced):
 
 @pytest.mark.parametrize("name", RIGS)
 def test_bytes_right_behind_a_stop_a_start_or_a_run_end_are_not_lost(traced, built, name):
-    rig, trace, link = traced(name)
+    _, trace, link = traced(name)
     run_s = short_run(link)
-    trials = [burst_trial(rig, trace, link, event, run_s) for event in BURST_EVENTS * 8]
+    trials = [burst_trial(trace, link, event, run_s) for event in BURST_EVENTS * 8]
     # Coverage, not the property: a run's end must fall in one of the host's bursts, which
     # the host cannot time exactly (six_chamber: 1 in 5 runs here). More runs until one does.
     while not any(t.covered for t in trials if t.event == "done") and len(trials) < 100:
-        trials.append(burst_trial(rig, trace, link, "done", run_s))
+        trials.append(burst_trial(trace, link, "done", run_s))
     assert [t for t in trials if t.lost_bytes] == []
     assert any(t.covered for t in trials if t.event == "done")
     measured = trace.update().interrupts_off[-1].cycles

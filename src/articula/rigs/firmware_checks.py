@@ -11,8 +11,9 @@ tests/firmware/test_safety_firmware.py asserts.
   restart as a watchdog's (DeviceResetError).
 - Commands in bursts at 1 Mbaud during a run: no byte lost (the USART's overruns, which the
   harness models, as the firmware counts them in STATUS and as the trace shows them).
-- A STOP or START with three STATUS behind it in the same write, and bursts of STATUS through
-  a run's own end (DONE): no byte lost while the firmware changes its outputs (issue 47).
+- A STOP or START with three STATUS behind it in the same write, and bursts that keep the line
+  busy through a run's own end (DONE): no byte lost while the firmware changes its outputs
+  (issue 47).
 """
 
 from __future__ import annotations
@@ -293,17 +294,14 @@ def short_run(link: Link) -> float:
     return 5 * period
 
 
-def burst_trial(
-    rig: FirmwareRig, trace: PinTrace, link: Link, event: str, run_s: float
-) -> BurstTrial:
+def burst_trial(trace: PinTrace, link: Link, event: str, run_s: float) -> BurstTrial:
     """A STOP or a START with three STATUS behind it in one write, or a short run that ends by
     itself (DONE) while the host keeps the line busy with bursts: the bytes the firmware lost
     meanwhile.
 
     Args:
-        rig: the firmware on its plant (`trace` is its harness's trace).
-        trace: the pin trace of `rig`.
-        link: the line to it, the run's settings loaded.
+        trace: the pin trace of the firmware's harness.
+        link: the line to the firmware, the run's settings loaded.
         event: "stop", "start" or "done".
         run_s: the duration of the run that ends by itself ("done") [s]: a few periods.
 
@@ -322,10 +320,12 @@ def burst_trial(
         link.notify_together([(Kind.STOP, b""), *BURST])
     else:
         link.command(Kind.START, struct.pack("<fI", run_s, 0), fresh=True)
-        while True:  # a burst, then its STATUS behind it: the line busy most of the time
+        for _ in range(100_000):  # a burst, then a STATUS behind it: the line busy most of the time
             link.notify_together([], then=_filler())
             if not link.status().running:
                 break
+        else:
+            raise DeviceError(f"{link.port}: a run of {run_s} s did not end")
         end = max(c for what, c in trace.update().events if what == "end")
         fill_cycles = round(FILL_S * CPU_HZ)
         covered = any(
