@@ -1,7 +1,8 @@
 """tools/interrupts_off.py bounds every section of an AVR program that runs with interrupts
 off (issue 47): on the rigs' firmware, within a byte's time at 1 Mbaud (160 cycles); on small
 programs, exactly the cycles the datasheet gives, the longer way of a branch, a callee to its
-ret, an interrupt's entry; and a loop or an indirect call has no bound."""
+ret, an interrupt's entry, and what the harness's trace measures; and a loop or an indirect
+call has no bound."""
 
 from __future__ import annotations
 
@@ -96,3 +97,25 @@ def test_a_loop_or_an_indirect_call_has_no_bound(built, tmp_path, body, why):
     [section] = _sections(elf, "main")
     assert section["cycles"] is None and why in section["why"]
     assert interrupts_off.report(elf)["max_cycles"] is None
+
+
+def test_the_harness_measures_a_section_as_the_tool_counts_it(built, tmp_path):
+    # A cli, 20 nops and a sei, over and over: 21 cycles each time, by both.
+    nops = "nop\\n" * 20
+    elf = _program(tmp_path, rf"""
+        #include <avr/interrupt.h>
+        int main(void) {{
+            sei();
+            for (;;) __asm__ volatile("cli\n {nops} sei");
+        }}""")  # fmt: skip
+    trace = tmp_path / "program.trace"
+    proc = subprocess.Popen([built / "harness", elf, "--trace", trace], stdout=subprocess.PIPE,
+                            text=True)  # fmt: skip
+    try:  # the harness says where its UART is after 20 ms of the program: sections by then
+        next(line for line in proc.stdout if line.startswith("uart0 at "))
+    finally:
+        proc.kill()
+        proc.wait(10)
+    measured = [int(line.split()[2]) for line in trace.read_text().splitlines()
+                if line.startswith("irqoff")]  # fmt: skip
+    assert measured == [21] == [s["cycles"] for s in _sections(elf, "main")]
