@@ -30,7 +30,13 @@
  * --trace FILE: a line "pins <cycle> <PORTA> <PORTB> <PORTC> <PORTE> <PORTH> <TCCR1A>
  * <TCCR3A> <TCCR4A> <OCR1A> <OCR3A> <OCR4A>" whenever one of those registers changes (after
  * the instruction that changed it), the host's and the firmware's frames (line.c), "run",
- * "end", "reset", "hang": what a logic analyser on the board would see.
+ * "end", "reset", "hang": what a logic analyser on the board would see. And, what it would
+ * not: "irqoff <cycle> <cycles> <address>" each time a section with interrupts off (SREG's
+ * I bit clear: a cli, an interrupt's entry, up to the sei, reti or SREG restore that sets it
+ * again) is the longest yet, at its end: its length in CPU cycles as simavr counts them
+ * (the chip's 5-cycle interrupt response not included) and the hex byte address it began
+ * at (after its cli, or the interrupt's vector). The start-up, before the first sei, is not
+ * such a section.
  *
  * Time: during a run the simulation runs as fast as the plant answers, while the host talks
  * (a byte within the last HOST_QUIET_CYCLES); otherwise, and always with --realtime, it keeps
@@ -103,6 +109,11 @@ static volatile sig_atomic_t reset_pressed, hang_pressed; /* SIGUSR1, SIGUSR2 */
 static avr_flashaddr_t hang_at;                            /* the firmware's `rjmp .` */
 static int hung;
 static void (*core_reset)(avr_t *);
+/* Interrupts off (SREG's I): on at the last look; once on since the (re)start; the section
+ * going on, from when and where; the longest so far. */
+static int interrupts_on, interrupts_were_on;
+static avr_cycle_count_t off_since, off_longest;
+static avr_flashaddr_t off_at;
 
 void trace_event(const char *what, const char *text) {
     if (!trace) return;
@@ -145,6 +156,25 @@ static avr_cycle_count_t encoder_edge(avr_t *a, avr_cycle_count_t when, void *pa
     avr_raise_irq(encoder_pin[0], pins[encoder_phase][0]);
     avr_raise_irq(encoder_pin[1], pins[encoder_phase][1]);
     return encoder_count == encoder_target ? 0 : when + edge_cycles;
+}
+
+/* After each instruction: a section with interrupts off begins or ends (the longest
+ * traced). A byte at 1 Mbaud takes 160 cycles: a section longer than that can overrun the
+ * USART. */
+static void watch_interrupts(void) {
+    int on = avr->sreg[S_I];
+    if (on == interrupts_on) return;
+    interrupts_on = on;
+    if (!on) {
+        off_since = avr->cycle;
+        off_at = avr->pc;
+    } else if (interrupts_were_on && avr->cycle - off_since > off_longest) {
+        off_longest = avr->cycle - off_since;
+        char text[48];
+        snprintf(text, sizeof text, "%llu %x", (unsigned long long)off_longest, (unsigned)off_at);
+        trace_event("irqoff", text);
+    }
+    interrupts_were_on |= on;
 }
 
 static uint16_t reg16(uint16_t low) { return (uint16_t)(avr->data[low] | (avr->data[low + 1] << 8)); }
@@ -282,6 +312,7 @@ static void board_reset(avr_t *a) {
     if (running && plant) printf("end\n"), fflush(stdout);
     running = 0;
     hung = 0;
+    interrupts_on = interrupts_were_on = 0; /* the start-up again, interrupts off */
     encoder_target = encoder_count;
     to_sensor.tail = to_sensor.head;
     line_reset();
@@ -397,7 +428,7 @@ int main(int argc, char **argv) {
     for (;;) {
         int state = avr_run(avr);
         if (state == cpu_Done || state == cpu_Crashed) return state == cpu_Done ? 0 : 1;
-        if (trace) trace_pins();
+        if (trace) trace_pins(), watch_interrupts();
         if (reset_pressed) {
             reset_pressed = 0;
             avr_reset(avr);

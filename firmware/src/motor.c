@@ -3,9 +3,9 @@
  * loops/motor_current.py), in float32.
  *
  * Each millisecond Timer1 starts a conversion of the ACS712 on A1; its completion interrupt
- * takes the code and the encoder's count with interrupts off, then runs the control step
- * with interrupts on (the UART is served meanwhile, and the step's timing does not depend
- * on what the main loop is doing): the moving average (4.17), the PI + feed-forward
+ * takes the code and the encoder's count and runs the control step, with interrupts on (the
+ * UART is served meanwhile, and the step's timing does not depend on what the main loop is
+ * doing): the moving average (4.17), the PI + feed-forward
  * (4.13)-(4.14) and the duty (4.15)-(4.16) to Timer3's 8-bit PWM on D5 (ENA) with the
  * H-bridge's direction on D24/D25; the speed loop (4.12) on the encoder's counts (D2/D3, both edges of both
  * channels) drives D6 (ENB, Timer4) and D26/D27. Safe state: both enables off the PWM and
@@ -170,26 +170,28 @@ static void step(uint16_t code, int32_t count) {
     put_raw(values + 6, duty2);
     rig_sample();
     if (++n >= steps) {
-        ATOMIC_BLOCK(ATOMIC_RESTORESTATE) { safe(); } /* the last step: outputs off now */
+        safe(); /* the last step: outputs off now */
         rig_done();
     }
 }
 
-/* The conversion is done: the sample taken with interrupts off, then the control step with
- * them on (the UART's receive interrupt comes within a byte). A conversion that ends while
- * a step is still under way (it overran its period) is not a sample: the run ends. */
-ISR(ADC_vect) {
+/* The conversion is done: the control step on its sample, with interrupts on from the
+ * interrupt's first instruction (ISR_NOBLOCK: its prologue saves every register a call may
+ * clobber, some 70 cycles, which with interrupts off would hold the UART's receive interrupt
+ * up by about a byte's time), the encoder's count read atomically. The next conversion ends
+ * a period later; one that ends while a step is still under way (it overran its period) is
+ * not a sample: the run ends. */
+ISR(ADC_vect, ISR_NOBLOCK) {
     probe_busy();
     if (in_step) {
         missed = 1;
         return;
     }
-    uint16_t code = ADC;
-    int32_t count = encoder;
     in_step = 1;
-    sei();
+    uint16_t code = ADC;
+    int32_t count;
+    ATOMIC_BLOCK(ATOMIC_FORCEON) { count = encoder; }
     step(code, count);
-    cli();
     in_step = 0;
     probe_idle();
 }
@@ -279,18 +281,21 @@ static uint8_t start(float duration, const char **why) {
 }
 
 /* Both H-bridges off: no more control ticks or samples, the enables taken off the PWM and
- * driven low (a fast PWM at duty 0 still pulses once a cycle), the direction pins low. */
+ * driven low (a fast PWM at duty 0 still pulses once a cycle), the direction pins low; in one
+ * atomic write of some 50 cycles (tools/interrupts_off.py). */
 static void safe(void) {
-    TIMSK1 = 0;
-    ADCSRA = (uint8_t)((ADCSRA & ~_BV(ADIE)) | _BV(ADIF)); /* ADIF: cleared by a 1 */
-    live = 0;
-    TCCR3A &= (uint8_t)~_BV(COM3A1);
-    TCCR4A &= (uint8_t)~_BV(COM4A1);
-    OCR3AL = 0;
-    OCR4AL = 0;
-    PORTE &= (uint8_t)~_BV(PE3);
-    PORTH &= (uint8_t)~_BV(PH3);
-    PORTA &= (uint8_t)~(_BV(PA2) | _BV(PA3) | _BV(PA4) | _BV(PA5));
+    ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+        TIMSK1 = 0;
+        ADCSRA = (uint8_t)((ADCSRA & ~_BV(ADIE)) | _BV(ADIF)); /* ADIF: cleared by a 1 */
+        live = 0;
+        TCCR3A &= (uint8_t)~_BV(COM3A1);
+        TCCR4A &= (uint8_t)~_BV(COM4A1);
+        PORTE &= (uint8_t)~_BV(PE3);
+        PORTH &= (uint8_t)~_BV(PH3);
+        PORTA &= (uint8_t)~(_BV(PA2) | _BV(PA3) | _BV(PA4) | _BV(PA5));
+        OCR3AL = 0;
+        OCR4AL = 0;
+    }
 }
 
 /* GET: the gains and the reference as SET_GAINS and SET_REFERENCE carry them. */

@@ -4,8 +4,8 @@
  *
  * Timer1 runs the valve's PWM on D11 (OC1A): 8333 ticks of 4 µs, 33.332 ms (the book's
  * 1/30 s to 0.01 %). At each period's start its overflow interrupt starts a conversion of
- * the flex sensor's divider on A0; the conversion's interrupt takes the code with interrupts
- * off, then evaluates, with interrupts on, the PID (2.2)-(2.4) with gains scheduled on the
+ * the flex sensor's divider on A0; the conversion's interrupt takes the code and evaluates,
+ * with interrupts on, the PID (2.2)-(2.4) with gains scheduled on the
  * reference (constant, piecewise or fuzzy), anti-windup at the 0-255 range, and writes the
  * period's duty. The pump on D8 runs during a run. Safe state: the valve's pin off the PWM
  * and low (closed), the pump off. */
@@ -121,25 +121,24 @@ static void step(uint16_t code) {
     sample[0] = reference, sample[1] = angle, sample[2] = count;
     rig_sample();
     if (++n >= steps) {
-        ATOMIC_BLOCK(ATOMIC_RESTORESTATE) { safe(); } /* the last step: valve and pump off */
+        safe(); /* the last step: valve and pump off */
         rig_done();
     }
 }
 
-/* The conversion is done: the sample taken with interrupts off, then the PID with them on
- * (the UART's receive interrupt comes within a byte). A conversion that ends while a step
- * is still under way (it overran its period) is not a sample: the run ends. */
-ISR(ADC_vect) {
+/* The conversion is done: the PID on its sample, with interrupts on from the interrupt's
+ * first instruction (ISR_NOBLOCK: its prologue saves every register a call may clobber, some
+ * 70 cycles, which with interrupts off would hold the UART's receive interrupt up by about a
+ * byte's time). The next conversion ends a period later; one that ends while a step is still
+ * under way (it overran its period) is not a sample: the run ends. */
+ISR(ADC_vect, ISR_NOBLOCK) {
     probe_busy();
     if (in_step) {
         missed = 1;
         return;
     }
-    uint16_t code = ADC;
     in_step = 1;
-    sei();
-    step(code);
-    cli();
+    step(ADC);
     in_step = 0;
     probe_idle();
 }
@@ -222,16 +221,19 @@ static uint8_t start(float duration, const char **why) {
 }
 
 /* Valve closed, pump off: no more control ticks or samples, the valve's pin taken off the PWM
- * and driven low (a fast PWM at duty 0 still pulses once a period). An open-loop output
- * (SET_OUTPUT) holds for one run only. */
+ * and driven low (a fast PWM at duty 0 still pulses once a period); in one atomic write of
+ * some 40 cycles (tools/interrupts_off.py). An open-loop output (SET_OUTPUT) holds for one
+ * run only. */
 static void safe(void) {
-    TIMSK1 = 0;
-    ADCSRA = (uint8_t)((ADCSRA & ~_BV(ADIE)) | _BV(ADIF)); /* ADIF: cleared by a 1 */
-    live = 0;
-    TCCR1A &= (uint8_t)~_BV(COM1A1);
-    OCR1A = 0;
-    PORTB &= (uint8_t)~_BV(PB5);
-    PORTH &= (uint8_t)~_BV(PH5);
+    ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+        TIMSK1 = 0;
+        ADCSRA = (uint8_t)((ADCSRA & ~_BV(ADIE)) | _BV(ADIF)); /* ADIF: cleared by a 1 */
+        live = 0;
+        TCCR1A &= (uint8_t)~_BV(COM1A1);
+        PORTB &= (uint8_t)~_BV(PB5);
+        PORTH &= (uint8_t)~_BV(PH5);
+        OCR1A = 0;
+    }
     open_loop = -1.0f;
 }
 

@@ -27,9 +27,10 @@ uint16_t crc16(const uint8_t *data, uint8_t length);
 /* Send one frame (type, the device's next seq, body) through uart_write. */
 void frame_send(uint8_t kind, const uint8_t *body, uint8_t length);
 /* Feed one received byte; returns 1 and fills *out when it completes a valid frame (a frame
- * that fails COBS or its CRC is dropped: the host sends it again). The COBS block and the
- * CRC are taken a byte at a time, so no byte costs the main loop more than a few dozen
- * cycles, the delimiter included. */
+ * that fails COBS or its CRC is dropped: the host sends it again). A byte within a frame
+ * costs the main loop some 30 cycles (COBS a byte at a time), so that it keeps up with the
+ * line beside the receive interrupt's 80; the delimiter checks the CRC, some 25 cycles a
+ * byte of the frame. */
 uint8_t frame_receive(uint8_t byte, struct command *out);
 /* ERROR naming a command: its seq, a code and a text (up to MAX_FRAME - 8 characters, what a
  * frame holds; tests/firmware checks every text of firmware/src fits). */

@@ -16,6 +16,7 @@
 #define MIN_HOST_TIMEOUT_MS 20 /* START's range for it */
 #define MAX_HOST_TIMEOUT_MS 60000
 #define REPLY_ROOM (MAX_FRAME + 2) /* the send queue's room for any reply: a frame, stuffed */
+#define RECEIVE_BATCH 32           /* bytes a main-loop pass takes at most (~1.5k cycles) */
 enum reset_cause { POWER_ON = 0, EXTERNAL = 1, WATCHDOG = 2, BROWN_OUT = 3 };
 enum run_end { NOT_ENDED = 0, ENDED_DONE = 1, ENDED_STOP = 2, ENDED_HOST = 3, ENDED_ERROR = 4 };
 
@@ -58,8 +59,11 @@ ISR(TIMER0_COMPA_vect) { clock_ms++; }
 
 /* The watchdog's first timeout (interrupt and reset mode): the main loop has not come round
  * for 32 ms, hung or late. Outputs off now; the chip resets at the next timeout unless the
- * main loop comes back, sees `stalled`, ends the run and arms the interrupt again. */
-ISR(WDT_vect) {
+ * main loop comes back, sees `stalled`, ends the run and arms the interrupt again. Interrupts
+ * on from its first instruction (safe() makes its own short atomic writes), so that its
+ * prologue does not hold the host's bytes up. A main loop hung with interrupts off gets no
+ * such interrupt: only the reset at the second timeout. */
+ISR(WDT_vect, ISR_NOBLOCK) {
     if (rig) rig->safe();
     stalled = 1;
 }
@@ -141,17 +145,11 @@ static void send_info(void) {
     frame_send(INFO, body, n);
 }
 
-/* The one way to the safe state: the rig's, with interrupts off, so that no interrupt runs
- * between its writes and nothing it disarms can fire after. */
-static void go_safe(void) {
-    ATOMIC_BLOCK(ATOMIC_RESTORESTATE) { rig->safe(); }
-}
-
 /* A run ends (`how`: enum run_end): outputs safe first, then the words. DONE waits for the
  * samples not yet sent; a STOP drops them; an end the device chose (the host's silence, an
  * error) drops them and says `why` in an ERROR naming the START. */
 static void end_run(uint8_t how, const char *why) {
-    go_safe();
+    rig->safe();
     probe_end();
     running = finished = 0;
     ended = how;
@@ -185,7 +183,7 @@ static void start(const struct command *c) {
         finished = draining = 0;
         uint8_t code = rig->start(duration, &why);
         if (code) {
-            go_safe();
+            rig->safe();
             send_error(c->seq, code, why);
             return;
         }
@@ -238,7 +236,7 @@ static void handle(const struct command *c) {
         return;
     case STOP:
         if (running) end_run(ENDED_STOP, 0);
-        else go_safe();
+        else rig->safe();
         draining = 0;
         ring_tail = ring_head;
         send_ack(c->seq);
@@ -292,6 +290,31 @@ static uint8_t send_sample(void) {
     return 1;
 }
 
+/* The bytes that came, in batches shorter than any frame (7 bytes), so that one ends in a
+ * batch at most; until a command has been answered or RECEIVE_BATCH bytes taken (the control
+ * step goes first), and only with room for a reply (the main loop never waits on the line
+ * during a run). Several batches a pass, so that a pass's own cost is spread over many bytes:
+ * at full line rate the receive interrupt takes half of each byte's 160 cycles. How many it
+ * took. */
+static uint8_t receive(void) {
+    if (uart_space() < REPLY_ROOM) return 0;
+    struct command command;
+    uint8_t bytes[6], took = 0, answered = 0;
+    while (!answered && took < RECEIVE_BATCH) {
+        uint8_t n = uart_take(bytes, sizeof bytes);
+        if (!n) break;
+        took = (uint8_t)(took + n);
+        for (uint8_t k = 0; k < n; k++) {
+            if (frame_receive(bytes[k], &command)) {
+                heard_ms = rig_clock_ms();
+                handle(&command); /* its reply fits: the room was there */
+                answered = 1;
+            }
+        }
+    }
+    return took;
+}
+
 /* The run's checks, once a main-loop pass: its control step, its end, the host's silence. */
 static void run_checks(void) {
     if (stalled) { /* the watchdog's interrupt put the outputs off: the main loop was late */
@@ -310,7 +333,7 @@ static void run_checks(void) {
 
 void rig_serve(const struct rig *program) {
     rig = program;
-    go_safe();
+    rig->safe();
     OCR0A = 249; /* TOP first (simavr reads it as the clock starts): 16 MHz / 64 / 250 */
     TCCR0A = _BV(WGM01);
     TCCR0B = _BV(CS01) | _BV(CS00);
@@ -323,22 +346,11 @@ void rig_serve(const struct rig *program) {
     uart_write(&delimiter, 1);
     send_info();
     set_sleep_mode(SLEEP_MODE_IDLE);
-    struct command command;
-    uint8_t bytes[6]; /* a batch: shorter than any frame (7 bytes), so one ends in it at most */
     for (;;) {
         wdt_reset();
+        uart_alive();
         run_checks();
-        /* The bytes that came, until a sample is flagged (the control step goes first), and
-         * only with room for a reply: the main loop never waits on the line during a run. */
-        uint8_t took = 0;
-        if (uart_space() >= REPLY_ROOM) took = uart_take(bytes, sizeof bytes);
-        for (uint8_t k = 0; k < took; k++) {
-            if (frame_receive(bytes[k], &command)) {
-                heard_ms = rig_clock_ms();
-                handle(&command); /* its reply fits: the room was there */
-            }
-        }
-        if (took) continue;
+        if (receive()) continue;
         if (send_sample()) continue;
         if (draining && ring_tail == ring_head) {
             uint8_t body[6] = {(uint8_t)(run_seq & 0xFF), (uint8_t)(run_seq >> 8)};

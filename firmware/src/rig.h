@@ -2,13 +2,15 @@
  * STOP, STREAM, STATUS, GET and the rig's own settings), the run's life and its one safe
  * state, the watchdog, the host timeout and a millisecond clock.
  *
- * Interrupts sample with interrupts off, for a few dozen cycles; a rig's control step then
- * runs with interrupts on (in its sample's interrupt, re-enabled, or in the main loop), so
- * the UART's receive interrupt is never held off for more than a fraction of a byte's time,
- * and the step's timing does not depend on what the main loop is doing. Outputs are written
- * with interrupts off and only while the run is live. Every end of a run (DONE, STOP, an
- * error, the host's silence, the watchdog, a reset) puts the outputs in the rig's safe state
- * through one function, with interrupts off. */
+ * No section with interrupts off (an interrupt's own, a cli's up to its sei or SREG restore)
+ * is longer than a byte's time at 1 Mbaud, 160 cycles, so the USART's 2-byte buffer never
+ * overruns: interrupts sample with interrupts off; a rig's control step then runs with
+ * interrupts on (in its sample's interrupt, re-enabled, or in the main loop), and its timing
+ * does not depend on what the main loop is doing. Outputs are written in short atomic
+ * writes and only while the run is live. Every end of a run (DONE, STOP, an error, the
+ * host's silence, the watchdog, a reset) puts the outputs in the rig's safe state through one
+ * function. tools/interrupts_off.py bounds every such section from the ELF; the harness's
+ * trace measures them (docs/guides/firmware.md). */
 #ifndef ARTICULA_RIG_H
 #define ARTICULA_RIG_H
 
@@ -34,11 +36,14 @@ struct rig {
     /* GET: the body of the setting `kind` (a SET_ command) as that command carries it, into
      * body (up to MAX_FRAME - 7 bytes); its length, or 0xFF for a setting this rig has not. */
     uint8_t (*setting)(uint8_t kind, uint8_t *body);
-    /* A run of `duration` [s] from rest: arm the control interrupts; 0 or an error code. */
+    /* A run of `duration` [s] from rest: its outputs and control interrupts armed in one
+     * short atomic write, the rest computed with interrupts on; 0 or an error code. */
     uint8_t (*start)(float duration, const char **why);
     /* The safe state: outputs off (as docs/protocol.md states per rig) and the control
-     * interrupts disarmed, their pending flags cleared. Called with interrupts off, at
-     * start-up and at every end of a run. */
+     * interrupts disarmed, their pending flags cleared, in one short atomic write (interrupts
+     * off for well under 160 cycles), so that no interrupt runs between its writes and
+     * nothing it disarms fires after. Called with interrupts on or off: at start-up, at every
+     * end of a run, from the watchdog's interrupt. */
     void (*safe)(void);
     /* The run's main-loop work, called over and over while it goes on: work the interrupts
      * flagged (rig_event), and the run's own checks; NULL, or a reason that ends the run in

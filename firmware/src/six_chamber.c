@@ -12,14 +12,15 @@
  * pressure: partial pressures need chamber pressure sensors the book's rig does not have.
  *
  * The tick's interrupt only plays the valve events the main loop scheduled at START, as a
- * timer's compare output would; everything else (the sensor's frames into samples, the
- * checks) runs in the main loop. Safe state: pump off, every chamber venting. A run ends in
- * it with an error when the sensor has sent no frame for SENSOR_TIMEOUT_MS. */
+ * timer's compare output would: one event a tick at most, the coils of all the chambers that
+ * change then, precomputed, so that it stays short; everything else (the sensor's frames
+ * into samples, the checks) runs in the main loop. Safe state: pump off, every chamber
+ * venting. A run ends in it with an error when the sensor has sent no frame for
+ * SENSOR_TIMEOUT_MS. */
 #include <avr/interrupt.h>
 #include <avr/io.h>
 #include <avr/pgmspace.h>
 #include <math.h>
-#include <string.h>
 #include <util/atomic.h>
 
 #ifdef FILL_TABLE /* make FILL_TABLE=fill.h: another actuator's (tools/fill_table.py --plant) */
@@ -51,62 +52,78 @@ static const char *const channels[][2] = {{"bend_x", "deg"}, {"bend_y", "deg"}};
 static float side = 0.0f, gauge = SUPPLY_PA, hold = 1.0f;
 static float delta = 0.0f, pulse_start = 0.0f, pulse_length = 0.0f;
 
-/* The run: valve events in tick order, the tick, the sensor's samples to take. */
+/* Valve coils to set on the two ports: which (mask) and which of them on (bits). */
+struct coils {
+    uint8_t mask_a, bits_a; /* PORTA: chambers 0-3 */
+    uint8_t mask_c, bits_c; /* PORTC: chambers 4-5 */
+};
+
+/* The run: valve events in tick order (one a tick), the tick, the sensor's samples to take;
+ * every chamber venting (the safe state's coils, set up by main). */
 struct event {
     uint32_t tick;
-    uint8_t port_c; /* the coils' port: 0 PORTA, 1 PORTC */
-    uint8_t mask, bits; /* the chamber's two coils, and those of them on */
+    struct coils coils;
 };
 static struct event events[MAX_EVENTS];
 static uint8_t event_count, next_event;
 static volatile uint32_t tick;
 static uint32_t samples_left;
 static uint16_t frame_ms; /* when the sensor's last frame was taken (rig_clock_ms) */
+static struct coils venting;
+static volatile uint8_t live; /* the run's valves may be driven (safe() ends that) */
 
-/* The sensor's frame, filled by the Serial1 interrupt, taken by the main loop. */
-static uint8_t frame[12];
-static volatile uint8_t frame_ready;
+/* The sensor's frames, filled by the Serial1 interrupt in turn: the one ready for the main
+ * loop is not written until it has been taken (no copy in the interrupt). */
+static uint8_t frames[2][12];
+static volatile uint8_t frame_ready, ready_at;
 
-/* A chamber's valve coils (fill, vent) in `mode`, as an event: its port, the two coils'
- * bits and those of them on. */
-static struct event coils(uint8_t chamber, uint8_t mode) {
+/* A chamber's valve coils (fill, vent) in `mode` added to `to` (replacing that chamber's). */
+static void add_coils(struct coils *to, uint8_t chamber, uint8_t mode) {
     uint8_t fill = mode == FILL, vent = mode == VENT;
-    if (chamber < 4)
-        return (struct event){0, 0, (uint8_t)(3 << (2 * chamber)),
-                              (uint8_t)(fill << (2 * chamber) | vent << (2 * chamber + 1))};
+    if (chamber < 4) {
+        uint8_t pair = (uint8_t)(3 << (2 * chamber));
+        to->mask_a |= pair;
+        to->bits_a = (uint8_t)((to->bits_a & ~pair) | fill << (2 * chamber) | vent << (2 * chamber + 1));
+        return;
+    }
     uint8_t at = (uint8_t)(7 - 2 * (chamber - 4)); /* D30 = PC7, D31 = PC6, D32 = PC5, D33 = PC4 */
-    return (struct event){0, 1, (uint8_t)(3 << (at - 1)), (uint8_t)(fill << at | vent << (at - 1))};
+    uint8_t pair = (uint8_t)(3 << (at - 1));
+    to->mask_c |= pair;
+    to->bits_c = (uint8_t)((to->bits_c & ~pair) | fill << at | vent << (at - 1));
 }
 
-/* An event's coils set (a port's read-modify-write: the caller keeps interrupts out). */
-static void apply(const struct event *e) {
-    if (e->port_c) PORTC = (uint8_t)((PORTC & ~e->mask) | e->bits);
-    else PORTA = (uint8_t)((PORTA & ~e->mask) | e->bits);
+/* Coils set: a read-modify-write of each port (the caller keeps interrupts out), some 20
+ * cycles. */
+static void apply(const struct coils *c) {
+    PORTA = (uint8_t)((PORTA & ~c->mask_a) | c->bits_a);
+    PORTC = (uint8_t)((PORTC & ~c->mask_c) | c->bits_c);
 }
 
-static void set_valve(uint8_t chamber, uint8_t mode) {
-    struct event e = coils(chamber, mode);
-    apply(&e);
-}
-
-/* The 10 kHz tick: the events that are due, their coils precomputed at START (a few dozen
- * cycles, so that the host's bytes are never kept waiting). */
-ISR(TIMER1_COMPA_vect) {
+/* The 10 kHz tick: the event that is due, its coils precomputed at START. With interrupts on
+ * from its first instruction (ISR_NOBLOCK: the 32-bit tick's prologue alone is some 60
+ * cycles), the coils set atomically and only while the run is live: the watchdog's safe(),
+ * nested in it, is not undone. */
+ISR(TIMER1_COMPA_vect, ISR_NOBLOCK) {
     probe_busy();
     uint32_t now = ++tick;
-    while (next_event < event_count && events[next_event].tick <= now) apply(&events[next_event++]);
+    if (next_event < event_count && events[next_event].tick <= now) {
+        ATOMIC_BLOCK(ATOMIC_FORCEON) {
+            if (live) apply(&events[next_event].coils);
+        }
+        next_event++;
+    }
     probe_idle();
 }
 
 /* Serial1: A5 5A, twelve bytes (roll, pitch, yaw float32), their byte sum. */
 ISR(USART1_RX_vect) {
-    static uint8_t at, sum, buffer[12];
+    static uint8_t at, sum, filling;
     uint8_t byte = UDR1;
     if (at == 0) at = byte == 0xA5;
     else if (at == 1) at = byte == 0x5A ? 2 : (byte == 0xA5);
-    else if (at < 14) buffer[at - 2] = byte, sum = (uint8_t)(at == 2 ? byte : sum + byte), at++;
+    else if (at < 14) frames[filling][at - 2] = byte, sum = (uint8_t)(at == 2 ? byte : sum + byte), at++;
     else {
-        if (byte == sum && !frame_ready) memcpy(frame, buffer, 12), frame_ready = 1, rig_event = 1;
+        if (byte == sum && !frame_ready) ready_at = filling, filling ^= 1, frame_ready = 1, rig_event = 1;
         at = 0;
     }
 }
@@ -122,12 +139,17 @@ static float fill_time(float fraction) {
     return lo + (at - k) * (hi - lo);
 }
 
+/* A chamber's valves to `mode` at `seconds` into the run: into the event of that tick (a
+ * later call for the same chamber and tick wins), or a new one in tick order. */
 static void add_event(float seconds, uint8_t chamber, uint8_t mode) {
-    struct event e = coils(chamber, mode);
-    e.tick = tick_at(seconds);
-    uint8_t k = event_count++;
-    while (k > 0 && events[k - 1].tick > e.tick) events[k] = events[k - 1], k--; /* stable */
-    events[k] = e;
+    uint32_t at = tick_at(seconds);
+    uint8_t k = 0;
+    while (k < event_count && events[k].tick < at) k++;
+    if (k == event_count || events[k].tick != at) {
+        for (uint8_t j = event_count++; j > k; j--) events[j] = events[j - 1];
+        events[k] = (struct event){at, {0, 0, 0, 0}};
+    }
+    add_coils(&events[k].coils, chamber, mode);
 }
 
 /* The run's main-loop work: a sensor frame into a sample, the bending vector of the top's
@@ -139,9 +161,10 @@ static const char *control(void) {
         return 0;
     }
     frame_ms = rig_clock_ms();
+    const uint8_t *frame = frames[ready_at];
     float roll = read_float(frame, 0) / DEG, pitch = read_float(frame, 4) / DEG;
     float yaw = read_float(frame, 8) / DEG;
-    frame_ready = 0;
+    frame_ready = 0; /* read: the interrupt may fill it again */
     /* The top's normal R ẑ for R = Rz(yaw) Ry(pitch) Rx(roll) (intrinsic Z-Y-X). */
     float cr = cosf(roll), sr = sinf(roll), sp = sinf(pitch), cy = cosf(yaw), sy = sinf(yaw);
     float nx = cr * sp * cy + sr * sy, ny = cr * sp * sy - sr * cy, nz = cr * cosf(pitch);
@@ -203,8 +226,11 @@ static uint8_t start(float duration, const char **why) {
         add_event(at + (pulse_length > open ? pulse_length : open), opposite, VENT);
     }
     frame_ms = rig_clock_ms();
+    struct coils first = venting; /* the side filling from the start, the others venting */
+    add_coils(&first, chamber, FILL);
     ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
-        for (uint8_t c = 0; c < CHAMBERS; c++) set_valve(c, c == chamber ? FILL : VENT);
+        apply(&first);
+        live = 1;
         frame_ready = 0;
         tick = 0;
         PORTH |= _BV(PH5); /* the pump */
@@ -215,13 +241,16 @@ static uint8_t start(float duration, const char **why) {
     return 0;
 }
 
-/* Pump off and every chamber venting: no more valve events, none pending. */
+/* Pump off and every chamber venting, no more valve events, none pending: in one atomic
+ * write of some 40 cycles (tools/interrupts_off.py). */
 static void safe(void) {
-    TIMSK1 = 0;
-    TIFR1 = _BV(OCF1A);
-    samples_left = 0;
-    PORTH &= (uint8_t)~_BV(PH5);
-    for (uint8_t c = 0; c < CHAMBERS; c++) set_valve(c, VENT);
+    ATOMIC_BLOCK(ATOMIC_RESTORESTATE) {
+        TIMSK1 = 0;
+        TIFR1 = _BV(OCF1A);
+        live = 0;
+        PORTH &= (uint8_t)~_BV(PH5);
+        apply(&venting);
+    }
 }
 
 /* GET: the actuation and the damping policy as SET_REFERENCE and SET_DAMPING carry them. */
@@ -257,6 +286,7 @@ int main(void) {
     UBRR1 = 16;                                            /* 117 647 baud, 2 % off 115 200 */
     UCSR1B = _BV(RXEN1) | _BV(RXCIE1);
     UCSR1C = _BV(UCSZ11) | _BV(UCSZ10);
+    for (uint8_t c = 0; c < CHAMBERS; c++) add_coils(&venting, c, VENT);
     OCR1A = TICKS - 1; /* TOP first: the timer starts with its clock */
     TCCR1B = _BV(WGM12) | _BV(CS10); /* CTC: the 10 kHz tick */
     rig_serve(&six_chamber);

@@ -17,9 +17,14 @@ uint16_t uart_space(void);
 uint8_t uart_take(uint8_t *out, uint8_t most);
 /* 1 when a received byte waits in the queue. */
 uint8_t uart_pending(void);
-/* Received bytes lost since start-up: the USART's data overruns (DOR: its 2-byte buffer was
- * full when a third byte ended) and bytes the receive queue had no room for; saturates at
- * 65535 (called at least once per 256 losses, as STATUS does, it misses none). */
+/* Received bytes lost since start-up: those of the USART's data overruns (DOR: its buffer
+ * and shift register were full when a further byte began), estimated from the time the
+ * receive interrupt was held off (uart.c), and the bytes the receive queue had no room for,
+ * exactly; saturates at 65535 (called at least once per 256 losses, as STATUS does, it misses
+ * none). */
 uint16_t uart_overruns(void);
+/* The main loop came round: the receive path is served (the start of an overrun's
+ * estimate). */
+void uart_alive(void);
 
 #endif

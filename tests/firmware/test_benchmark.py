@@ -25,3 +25,8 @@ def test_firmware_benchmark_prints_its_keys(built):
         assert 0 < m["flash_bytes"][program] < 256 * 1024
         assert 0 < m["ram_bytes"][program] < 8192
     assert m["firmware_run_s"] > 0 and m["simulation_run_s"] > 0
+    for program in ("motor", "pneunet", "six_chamber"):  # issue 47: no byte dropped
+        assert m["burst_trials"][program] >= 100
+        assert m["burst_after_stop_lost_bytes"][program] == 0
+        off = m["max_interrupts_off_cycles"][program]
+        assert 0 < off["measured"] <= off["static"] <= 160

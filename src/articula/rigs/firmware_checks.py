@@ -11,6 +11,9 @@ tests/firmware/test_safety_firmware.py asserts.
   restart as a watchdog's (DeviceResetError).
 - Commands in bursts at 1 Mbaud during a run: no byte lost (the USART's overruns, which the
   harness models, as the firmware counts them in STATUS and as the trace shows them).
+- A STOP or START with three STATUS behind it in the same write, and bursts that keep the line
+  busy through a run's own end (DONE): no byte lost while the firmware changes its outputs
+  (issue 47).
 """
 
 from __future__ import annotations
@@ -25,11 +28,17 @@ from articula.errors import DeviceError
 from articula.rigs.firmware import FirmwareRig
 from articula.rigs.link import DeviceResetError, Link
 from articula.rigs.pin_trace import CPU_HZ, PinTrace, active_outputs
-from articula.rigs.protocol import Kind, ResetCause
+from articula.rigs.protocol import Kind, ResetCause, RigKind
 from articula.rigs.run import run_program
 
 LONG_RUN_S = 30.0  # [s] a run that only a STOP, the host's silence or a hang ends
-WATCHDOG_S = 0.0328  # [s] the watchdog's timeout: 4096 cycles of its 128 kHz oscillator (rig.c)
+WATCHDOG_S = 0.032  # [s] the watchdog's timeout: 4096 cycles of its 128 kHz oscillator (rig.c)
+BYTE_S = 10e-6  # [s] a byte on the line at 1 Mbaud (8N1)
+BURST = [(Kind.STATUS, b"")] * 3  # 21 bytes back to back: 210 µs at 1 Mbaud
+# [s] a burst that keeps the line busy through a run's end: 200 bytes, which the 256-byte
+# receive queue holds even while a run's main loop takes them slower than they come
+FILL_S = 0.002
+BURST_EVENTS = ("stop", "start", "done")
 
 
 @dataclass(frozen=True)
@@ -233,6 +242,100 @@ def traffic_trial(rig: FirmwareRig, trace: PinTrace, link: Link, bursts: int = 5
     lost = link.status().rx_overruns - before
     traced = sum(1 for what, _ in trace.update().events if what == "overrun") - seen
     return max(lost, traced)
+
+
+@dataclass(frozen=True)
+class BurstTrial:
+    """One change of the outputs (a STOP, a START, a run's end) with the host's bytes coming
+    at full line rate.
+
+    Attributes:
+        event: "stop", "start" or "done".
+        lost_bytes: received bytes the firmware lost: the trace's overruns, or its own count
+            (STATUS) when that is larger.
+        covered: the host's bytes were on the line right after the event: for a STOP or a
+            START the burst behind it in the same write; for a run's end (the trace's
+            "end"), one of the host's bursts was on the line then.
+    """
+
+    event: str
+    lost_bytes: int
+    covered: bool
+
+
+def _overruns(trace: PinTrace) -> int:
+    """The bytes the harness's USART has lost so far (the trace's "overrun" lines)."""
+    return sum(1 for what, _ in trace.update().events if what == "overrun")
+
+
+def _filler() -> bytes:
+    """FILL_S of the line at 1 Mbaud that the device drops unanswered: one overlong frame
+    (its delimiter last), so it keeps the line busy without filling the send queue."""
+    return b"\x55" * round(FILL_S / BYTE_S - 1) + b"\0"
+
+
+def short_run(link: Link) -> float:
+    """A run that ends by itself a few periods in, for `burst_trial`'s "done": its duration;
+    on the six-chamber rig, whose run must outlast the actuation's hold, the hold set to two
+    periods first.
+
+    Args:
+        link: the line to the rig.
+
+    Returns:
+        The run's duration [s].
+    """
+    period = link.info.sample_period_us * 1e-6
+    if link.info.rig != RigKind.SIX_CHAMBER:
+        return 3 * period
+    reference = bytearray(link.setting(Kind.SET_REFERENCE))
+    reference[10:14] = struct.pack("<f", 2 * period)  # hold [s] (docs/protocol.md)
+    link.command(Kind.SET_REFERENCE, bytes(reference))
+    return 5 * period
+
+
+def burst_trial(trace: PinTrace, link: Link, event: str, run_s: float) -> BurstTrial:
+    """A STOP or a START with three STATUS behind it in one write, or a short run that ends by
+    itself (DONE) while the host keeps the line busy with bursts: the bytes the firmware lost
+    meanwhile.
+
+    Args:
+        trace: the pin trace of the firmware's harness.
+        link: the line to the firmware, the run's settings loaded.
+        event: "stop", "start" or "done".
+        run_s: the duration of the run that ends by itself ("done") [s]: a few periods.
+
+    Returns:
+        The trial.
+    """
+    before, seen = link.status().rx_overruns, _overruns(trace)
+    covered = True
+    if event == "start":
+        link.notify_together([(Kind.START, struct.pack("<fI", LONG_RUN_S, 0)), *BURST])
+        link.status()  # past the burst: the run is under way
+        link.command(Kind.STOP)
+    elif event == "stop":
+        link.command(Kind.START, struct.pack("<fI", LONG_RUN_S, 0), fresh=True)
+        link.next_frame(1.0)  # a sample: the run is under way
+        link.notify_together([(Kind.STOP, b""), *BURST])
+    else:
+        link.command(Kind.START, struct.pack("<fI", run_s, 0), fresh=True)
+        for _ in range(100_000):  # a burst, then a STATUS behind it: the line busy most of the time
+            link.notify_together([], then=_filler())
+            if not link.status().running:
+                break
+        else:
+            raise DeviceError(f"{link.port}: a run of {run_s} s did not end")
+        end = max(c for what, c in trace.update().events if what == "end")
+        fill_cycles = round(FILL_S * CPU_HZ)
+        covered = any(
+            f.cycle - fill_cycles <= end <= f.cycle
+            for f in trace.frames
+            if f.from_host and f.frame is None
+        )
+    lost = max(link.status().rx_overruns - before, _overruns(trace) - seen)
+    link.inbox.clear()
+    return BurstTrial(event, lost, covered)
 
 
 def active_now(rig: FirmwareRig, trace: PinTrace) -> list[str]:

@@ -185,6 +185,26 @@ class Link:
         self._seq = (self._seq + 1) & 0xFFFF
         self._write(protocol.encode(kind, self._seq, body))
 
+    def notify_together(self, commands: list[tuple[Kind, bytes]], then: bytes = b"") -> list[int]:
+        """Send several commands in one write, back to back on the line, without waiting
+        for their answers (a test of the device's reception at full line rate).
+
+        Args:
+            commands: (message type, body) of each, in order.
+            then: bytes to write after them in the same write (e.g. damaged frames, which the
+                device drops unanswered, to keep the line busy).
+
+        Returns:
+            Their sequence numbers.
+        """
+        wire, seqs = b"", []
+        for kind, body in commands:
+            self._seq = (self._seq + 1) & 0xFFFF
+            wire += protocol.encode(kind, self._seq, body)
+            seqs.append(self._seq)
+        self._write(wire + then)
+        return seqs
+
     def status(self) -> Status:
         """Ask the device for its STATUS.
 

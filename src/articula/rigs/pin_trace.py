@@ -3,9 +3,10 @@ back as the output registers over time and the frames on the host's line.
 
 The harness writes a line whenever a traced register changes ("pins"), per frame the host
 sent as it ends on the line ("rx") and per frame the firmware sent as its delimiter goes out
-("tx"), per byte its USART lost ("overrun"), and at a run's start and end, a reset and a
-hang. Times are CPU cycles at 16 MHz. `active_outputs` says, per rig, which outputs are
-driven in a register state: anything but the safe state of docs/protocol.md.
+("tx"), per byte its USART lost ("overrun"), at a run's start and end, a reset and a hang,
+and each time a section with interrupts off is the longest yet ("irqoff"). Times are CPU
+cycles at 16 MHz. `active_outputs` says, per rig, which outputs are driven in a register
+state: anything but the safe state of docs/protocol.md.
 """
 
 from __future__ import annotations
@@ -69,6 +70,24 @@ class LineFrame:
     frame: Frame | None
 
 
+@dataclass(frozen=True)
+class InterruptsOff:
+    """A section with interrupts off (SREG's I bit clear), the longest since the harness
+    started when it ended.
+
+    Attributes:
+        cycle: when it ended [CPU cycles].
+        cycles: its length, as simavr counts it (the chip's 5-cycle interrupt response not
+            included) [CPU cycles].
+        address: the flash byte address it began at: after its `cli`, or an interrupt's
+            vector.
+    """
+
+    cycle: int
+    cycles: int
+    address: int
+
+
 def active_outputs(program: str, state: PinState) -> list[str]:
     """The outputs `state` drives, by name; [] in the safe state.
 
@@ -112,6 +131,7 @@ class PinTrace:
         self.events: list[
             tuple[str, int]
         ] = []  # ("run" | "end" | "reset" | "hang" | "overrun", cycle)
+        self.interrupts_off: list[InterruptsOff] = []  # each the longest yet, in order
         self._offset = 0
 
     def update(self) -> PinTrace:
@@ -129,6 +149,9 @@ class PinTrace:
             what, cycle, *rest = line.split()
             if what == "pins":
                 self.pins.append(PinState(int(cycle), *map(int, rest)))
+            elif what == "irqoff":
+                off = InterruptsOff(int(cycle), int(rest[0]), int(rest[1], 16))
+                self.interrupts_off.append(off)
             elif what in ("rx", "tx"):
                 self.frames.append(LineFrame(int(cycle), what == "rx", _decode(rest)))
             else:
