@@ -2,10 +2,16 @@
 registers, the servo toward servoJ's target, the safety checks a real controller makes, and
 the MuJoCo twin of the arm (sim.twin) under it.
 
+servoJ is modelled as a rate-limited first-order follower: the commanded joint speed is the
+target's distance over lookahead_time, within each joint's speed limit, changing by at most
+its acceleration limit per second (UR documents lookahead_time as smoothing and gain as a
+proportional gain; the fake checks gain within its range and does not use it otherwise).
+
 What it enforces, as a real controller does:
-- a servoJ target outside the joint limits, or one that asks a joint to move faster than its
-  speed limit (SPEED_MARGIN over the URDF's) — a jump in the set-point — is a protective stop:
-  the arm brakes, the program pauses, safety_status_bits says so;
+- a servoJ target outside the joint limits, or farther from the commanded position than
+  JUMP × the joint's speed limit × lookahead_time (a jump in the set-point: more than the
+  follower's own lag at full speed), is a protective stop: the arm brakes, the program
+  pauses, safety_status_bits says so;
 - the RTDE watchdog (setWatchdog): when the watched input register is not written at the set
   frequency, the program stops and the arm brakes;
 - stopScript, servoStop, stopL / stopJ, the dashboard's `stop`: the arm brakes.
@@ -30,7 +36,7 @@ __all__ = ["PAUSED", "PLAYING", "RATE", "STOPPED", "Controller", "Event"]
 
 RATE = 500.0  # [Hz] an e-Series controller's cycle
 STOPPED, PLAYING, PAUSED = 1, 2, 4  # runtime_state
-SPEED_MARGIN = 1.05  # a servoJ target asking more than this × a joint's speed limit is a jump
+JUMP = 2.0  # a servoJ target this many times the follower's lag at full speed away is a jump
 LOOKAHEAD, GAIN = (0.03, 0.2), (100.0, 2000.0)  # servoj's ranges
 NORMAL, PROTECTIVE = 1, 3  # safety_mode
 
@@ -114,15 +120,16 @@ class Controller:
         self._outputs[f"output_int_register_{index}"] = int(value)
 
     def servoj(self, q: list[float], t: float, lookahead_time: float, gain: float) -> None:
-        """Servo toward q [rad], reached in t [s]; lookahead_time [s] and gain are checked
-        within servoj's ranges (a value outside stops the program, as a runtime error)."""
+        """Servo toward q [rad] (t [s], the call's blocking time, is one cycle here);
+        lookahead_time [s] and gain are checked within servoj's ranges (a value outside stops
+        the program, as a runtime error)."""
         if not LOOKAHEAD[0] <= lookahead_time <= LOOKAHEAD[1] or not GAIN[0] <= gain <= GAIN[1]:
             self._stop_program(
                 f"servoj: lookahead_time {lookahead_time:g} s or gain {gain:g} outside "
                 f"[{LOOKAHEAD[0]}, {LOOKAHEAD[1]}] s, [{GAIN[0]:g}, {GAIN[1]:g}]"
             )
             return
-        self._servo = (np.array(q, dtype=float), max(float(t), self.h))
+        self._servo = (np.array(q, dtype=float), lookahead_time)
 
     def brake(self, why: str) -> None:
         """Stop servoing and bring the arm to rest."""
@@ -212,32 +219,37 @@ class Controller:
             self.q_cmd = self.q_cmd + self.qd_cmd * self.h
             self._braking = bool(np.any(self.qd_cmd))
         elif self._servo is not None and self.runtime_state == PLAYING:
-            target, t = self._servo
-            q = self.q_cmd + (target - self.q_cmd) * min(1.0, self.h / t)
-            if self._safe(q):
-                self.qd_cmd, self.q_cmd = (q - self.q_cmd) / self.h, q
+            target, lookahead = self._servo
+            if self._safe(target, lookahead):
+                robot, step = self.robot, self.robot.acceleration_limit * self.h
+                wanted = np.clip((target - self.q_cmd) / lookahead, -robot.velocity_limit,
+                                 robot.velocity_limit)  # fmt: skip
+                self.qd_cmd = self.qd_cmd + np.clip(wanted - self.qd_cmd, -step, step)
+                self.q_cmd = self.q_cmd + self.qd_cmd * self.h
         else:
             self.qd_cmd = np.zeros_like(self.qd_cmd)
         self._qdd = (self.qd_cmd - previous) / self.h
 
-    def _safe(self, q: np.ndarray) -> bool:
-        """Whether a commanded step keeps the joint limits and speeds (else a protective stop)."""
+    def _safe(self, target: np.ndarray, lookahead: float) -> bool:
+        """Whether a servoJ target keeps the joint limits and is no jump (else a protective
+        stop)."""
         robot, names = self.robot, self.robot.joint_names
-        outside = np.flatnonzero((q < robot.lower) | (q > robot.upper))
+        outside = np.flatnonzero((target < robot.lower) | (target > robot.upper))
         if outside.size:
             j = int(outside[0])
             self.protective_stop(
-                f"{names[j]} set-point {q[j]:.4f} rad outside its limits "
+                f"{names[j]} set-point {target[j]:.4f} rad outside its limits "
                 f"[{robot.lower[j]:.4f}, {robot.upper[j]:.4f}]"
             )
             return False
-        speed = np.abs(q - self.q_cmd) / self.h
-        over = np.flatnonzero(speed > SPEED_MARGIN * robot.velocity_limit)
+        gap = np.abs(target - self.q_cmd)
+        over = np.flatnonzero(gap > JUMP * robot.velocity_limit * lookahead)
         if over.size:
             j = int(over[0])
             self.protective_stop(
-                f"{names[j]} set-point jumps {abs(q[j] - self.q_cmd[j]):.4f} rad in one cycle "
-                f"({speed[j]:.2f} rad/s, over its {robot.velocity_limit[j]:.2f} rad/s)"
+                f"{names[j]} set-point jumps {gap[j]:.4f} rad from the commanded "
+                f"{self.q_cmd[j]:.4f} rad (more than {JUMP:g} × {robot.velocity_limit[j]:.2f} "
+                f"rad/s × lookahead {lookahead:g} s)"
             )
             return False
         return True

@@ -8,6 +8,7 @@ one fake takes one address; tests give each fake its own loopback address (127.0
 
 from __future__ import annotations
 
+import contextlib
 import socket
 import threading
 from collections.abc import Callable
@@ -93,6 +94,8 @@ class FakeUR:
         """Stop the cycle, hang up on every client, stop listening."""
         self._stop.set()
         for listener in self._listeners:
+            with contextlib.suppress(OSError):  # wakes its accept() (a close alone does not)
+                listener.shutdown(socket.SHUT_RDWR)
             listener.close()
         for session in list(self._sessions):
             session.close()
