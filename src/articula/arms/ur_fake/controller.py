@@ -8,7 +8,8 @@ its acceleration limit per second (UR documents lookahead_time as smoothing and 
 proportional gain; the fake checks gain within its range and does not use it otherwise).
 
 What it enforces, as a real controller does:
-- a servoJ target outside the joint limits, or farther from the commanded position than
+- a servoJ target outside the joint limits, a commanded motion that could not brake before
+  a limit, or a target farther from the commanded position than
   JUMP × the joint's speed limit × lookahead_time (a jump in the set-point: more than the
   follower's own lag at full speed), is a protective stop: the arm brakes, the program
   pauses, safety_status_bits says so;
@@ -73,7 +74,7 @@ class Controller:
         runtime_state: STOPPED, PLAYING or PAUSED.
         protective: in a protective stop.
         events: every Event so far.
-        log: each cycle's (t, measured q (6,), commanded q (6,), runtime_state).
+        log: each cycle's (t, measured q (6,), commanded q (6,), runtime_state, contacts).
         contacts: the most contacts MuJoCo saw in a cycle.
         lock: held while a cycle runs or registers are written.
     """
@@ -101,7 +102,7 @@ class Controller:
         self._braking = False
         self._watchdog: tuple[str, float] | None = None
         self.events: list[Event] = []
-        self.log: list[tuple[float, np.ndarray, np.ndarray, int]] = []
+        self.log: list[tuple[float, np.ndarray, np.ndarray, int, int]] = []
         self.contacts = 0
         self._on_event = on_event
 
@@ -204,9 +205,10 @@ class Controller:
         self.twin.place_obstacles(self.t + self.h)
         self.twin.step(self.q_cmd, self.qd_cmd)
         self.t += self.h
-        self.contacts = max(self.contacts, self.twin.contacts())
+        contacts = self.twin.contacts()
+        self.contacts = max(self.contacts, contacts)
         q = self.twin.q
-        self.log.append((self.t, q, self.q_cmd.copy(), self.runtime_state))
+        self.log.append((self.t, q, self.q_cmd.copy(), self.runtime_state, contacts))
         self.changed.notify_all()
         return self._output_values(q)
 
@@ -233,15 +235,18 @@ class Controller:
     def _safe(self, target: np.ndarray, lookahead: float) -> bool:
         """Whether a servoJ target keeps the joint limits and is no jump (else a protective
         stop)."""
-        robot, names = self.robot, self.robot.joint_names
-        outside = np.flatnonzero((target < robot.lower) | (target > robot.upper))
-        if outside.size:
-            j = int(outside[0])
-            self.protective_stop(
-                f"{names[j]} set-point {target[j]:.4f} rad outside its limits "
-                f"[{robot.lower[j]:.4f}, {robot.upper[j]:.4f}]"
-            )
-            return False
+        robot, names, qd = self.robot, self.robot.joint_names, self.qd_cmd
+        # where the commanded motion would stop if it braked after this cycle
+        stop = self.q_cmd + qd * self.h + qd * np.abs(qd) / (2 * robot.acceleration_limit)
+        for q, what in ((target, "set-point"), (stop, "braking from its motion")):
+            outside = np.flatnonzero((q < robot.lower) | (q > robot.upper))
+            if outside.size:
+                j = int(outside[0])
+                self.protective_stop(
+                    f"{names[j]} {what} reaches {q[j]:.4f} rad, outside its limits "
+                    f"[{robot.lower[j]:.4f}, {robot.upper[j]:.4f}]"
+                )
+                return False
         gap = np.abs(target - self.q_cmd)
         over = np.flatnonzero(gap > JUMP * robot.velocity_limit * lookahead)
         if over.size:

@@ -105,7 +105,7 @@ class FakeUR:
 
     def write_log(self, path: Path) -> None:
         """The controller's log of every cycle as a Parquet table: t [s], q_1..q_6 (measured
-        [rad]), qc_1..qc_6 (commanded [rad]), runtime_state.
+        [rad]), qc_1..qc_6 (commanded [rad]), runtime_state, contacts (MuJoCo's).
 
         Args:
             path: the file to write.
@@ -121,6 +121,7 @@ class FakeUR:
         columns = {"t": t} | {f"q_{j + 1}": q[:, j] for j in range(6)}
         columns |= {f"qc_{j + 1}": qc[:, j] for j in range(6)}
         columns |= {"runtime_state": np.array([row[3] for row in log])}
+        columns |= {"contacts": np.array([row[4] for row in log])}
         write_table(path, pa.table(columns))
 
     def _spawn(self, target: Callable[..., None], *args: object) -> None:
