@@ -14,6 +14,7 @@ import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 import pyarrow.parquet as pq
@@ -42,13 +43,17 @@ def scene_file(folder: Path, duration: float = 4.0, robot: dict | None = None) -
 
 
 class Process:
-    """A CLI process whose stdout and stderr lines are collected as they come.
+    """A CLI process whose stdout and stderr lines are collected as they come; each one a
+    test leaves running is killed after it (conftest).
 
     Args:
         args: the articula command's arguments.
     """
 
+    running: ClassVar[list[Process]] = []
+
     def __init__(self, *args: str) -> None:
+        Process.running.append(self)
         self.lines: list[str] = []
         self._changed = threading.Condition()
         self.process = subprocess.Popen(
@@ -87,6 +92,15 @@ class Process:
         if self.process.poll() is None:
             self.process.send_signal(sig)
         return self.process.wait(HANG)
+
+    @classmethod
+    def kill_all(cls) -> None:
+        """Kill every process a test left running (a failed test's)."""
+        for process in cls.running:
+            if process.process.poll() is None:
+                process.process.kill()
+                process.process.wait()
+        cls.running.clear()
 
 
 class Fake(Process):

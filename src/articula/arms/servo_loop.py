@@ -25,7 +25,7 @@ from articula.robots.model import RobotModel
 
 __all__ = ["AHEAD", "ServoLoop"]
 
-AHEAD = 2  # [periods] how far the planner may run ahead of the stream
+AHEAD = 3  # [periods] how far the planner may run ahead of the stream (its stall bound)
 PUSH_TIMEOUT = 5.0  # [s] a push that waits longer: the servo thread is wedged (a bug)
 
 
@@ -103,6 +103,15 @@ class ServoLoop:
             The joints (on the arm's branch) and the arm's time of them.
         """
         return self.measured[-1]
+
+    def measurement(self) -> tuple[int, Measured]:
+        """The last measurement and how far the stream was then.
+
+        Returns:
+            The whole periods the stream had played when it was taken, and the measurement.
+        """
+        ticks = len(self.measured) - 1
+        return ticks // self.stream.ticks, self.measured[ticks]
 
     def stop(self) -> None:
         """Play the stream's braking path and stop the arm; returns when it is done (also

@@ -26,6 +26,7 @@ from articula.arms.servo_loop import ServoLoop
 from articula.errors import ArticulaError, ConfigError, DeviceError
 from articula.experiments.drive_record import DriveRun, write_drive
 from articula.experiments.plan import PlanSetup, build_plan, load_plan
+from articula.loops.online import MAX_LAG
 from articula.loops.servo import ServoLimits, ServoStream, ticks_per_period
 from articula.runs.folders import check_out
 from articula.signals import Terminated
@@ -167,7 +168,9 @@ def drive(
     failure: BaseException | None = None
     try:
         for k in range(periods):
-            q = controller.step(plan.reference(k * dt), q_measured=robot.wrap(loop.latest().q))
+            played, measured = loop.measurement()  # it answers the target of period played - 1
+            lag = min(max(k - played, 0), MAX_LAG)
+            q = controller.step(plan.reference(k * dt), q_measured=robot.wrap(measured.q), lag=lag)
             loop.push(q)
             run.setpoints.append(q)
     except (KeyboardInterrupt, Terminated, ArticulaError) as exc:

@@ -14,6 +14,7 @@ and a planned run share one code path:
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -27,6 +28,7 @@ from articula.scene.scene import Scene
 
 MAX_LEAD = 0.05  # [m] the largest correction of a target for the tool's lag (anti-windup)
 LEAD_TIME = 1.0  # [s] time constant of that correction: the measured error integrated over it
+MAX_LAG = 16  # [periods] the oldest period a measurement may answer (step's lag)
 
 
 class LivePose:
@@ -103,6 +105,7 @@ class OnlineController:
         self.lead = np.zeros(3)
         self.held: Target | None = None  # the start's orientation and tool axis
         self.target: Target | None = None  # the last period's, complete
+        self._targets: deque[Target] = deque(maxlen=MAX_LAG + 1)  # the last periods', newest last
 
     @classmethod
     def from_spec(
@@ -190,6 +193,7 @@ class OnlineController:
             self.planner.follow(moving * self.dt)
         self.q, self.q_measured, self.periods = start, start.copy(), 0
         self.lead, self.target = np.zeros(3), None  # nothing measured against yet
+        self._targets.clear()
         return start.copy()
 
     def step(
@@ -197,6 +201,7 @@ class OnlineController:
         target: Sequence[float] | np.ndarray | Target,
         obstacle_poses: Mapping[str, np.ndarray] | None = None,
         q_measured: Sequence[float] | np.ndarray | None = None,
+        lag: int = 0,
     ) -> np.ndarray:
         """One control period toward the target; obstacle_poses moves live obstacles first.
 
@@ -214,6 +219,9 @@ class OnlineController:
                 moves.
             q_measured: the arm's joint positions measured at the start of the period, shape
                 (n,) [rad]; None: the lag found last (none before any measurement) stays.
+            lag: how many periods before the last one q_measured was taken (a pipelined loop
+                plans ahead of the arm: its measurement answers an older period's target);
+                0 to MAX_LAG.
 
         Returns:
             The new joint positions to send to the arm, shape (n,) [rad] (continuous joints
@@ -236,11 +244,15 @@ class OnlineController:
                 raise ConfigError(f"obstacle_poses.{name}", str(exc)) from None
         if measured is not None:
             self.q_measured = measured
-            if self.target is not None:  # the last period's target, which the arm measured aims at
-                error = self.target.position - robot.ee_position(measured)
+            if not 0 <= lag <= MAX_LAG:
+                raise ConfigError("lag", f"must be within [0, {MAX_LAG}] periods (got {lag})")
+            if len(self._targets) > lag:  # the target the measured arm aims at
+                aimed = self._targets[-1 - lag]
+                error = aimed.position - robot.ee_position(measured)
                 lead = self.lead + self.dt / LEAD_TIME * error
                 self.lead = lead * min(1.0, MAX_LEAD / max(float(np.linalg.norm(lead)), 1e-12))
         self.target = self._complete(target)
+        self._targets.append(self.target)
         led = self.target
         if self.lead.any():
             led = Target(self.target.position + self.lead, self.target.rotation, self.target.axis)

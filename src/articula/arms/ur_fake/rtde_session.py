@@ -5,6 +5,7 @@ ways. Each packet is a big-endian header (uint16 size with the header, uint8 typ
 
 from __future__ import annotations
 
+import contextlib
 import socket
 import struct
 import threading
@@ -69,8 +70,10 @@ class RtdeSession:
             return
         try:
             self._send(DATA_PACKAGE, recipe.pack(values))
-        except OSError:
-            self.close()
+        except OSError:  # the client is gone: its own thread cleans up (the caller holds the
+            self.started = False  # controller's lock, which close() takes)
+            with contextlib.suppress(OSError):
+                self._conn.shutdown(socket.SHUT_RDWR)
 
     def close(self) -> None:
         """Hang up and release the input registers this client held."""
