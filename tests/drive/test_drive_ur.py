@@ -127,8 +127,9 @@ def test_a_controller_killed_mid_run_ends_the_drive_in_one_line_with_its_folder(
     _wait_until_moving(fake)
     fake.end(signal.SIGKILL)
     assert drive.process.wait() == 1
-    errors = [line for line in drive.lines if line.startswith("error:")]
-    assert len(errors) == 1 and "ur:" in errors[0], drive.lines
+    assert len(drive.lines) == 2 and drive.lines[1].startswith("error:"), drive.lines
+    assert "ur:" in drive.lines[1]  # "streaming ...", then the one line
     record = json.loads((tmp_path / "run/record.json").read_text())
     assert record["drive"]["outcome"].startswith("the arm failed")
+    assert record["drive"]["client_messages"]  # ur-rtde's own lines, kept off the terminal
     assert (tmp_path / "run/trace.parquet").exists()

@@ -72,6 +72,7 @@ def test_a_jump_in_the_set_point_is_a_protective_stop(scene, tmp_path):
     line = fake.wait_for("protective stop")
     assert "shoulder_lift_joint set-point jumps 0.3000 rad" in line
     until(receive.isProtectiveStopped)
+    until(lambda: not control.isProgramRunning())  # the client's own view: paused
     assert not control.servoJ(list(q), 0.0, 0.0, TICK, LOOKAHEAD, GAIN)  # refused now
     control.disconnect()
     receive.disconnect()

@@ -5,6 +5,9 @@ pulled)."""
 
 from __future__ import annotations
 
+import os
+import sys
+import tempfile
 from typing import Any
 
 import numpy as np
@@ -32,12 +35,16 @@ class URArm:
     Attributes:
         rate: the servo rate [Hz].
         host: the controller's address.
+        messages: the lines ur-rtde's C++ client wrote while connected (kept off the terminal,
+            whose lines are the command's own; a drive keeps them in its record).
     """
 
     def __init__(self, host: str, rate: float = 500.0) -> None:
         self.host, self.rate = host, float(rate)
         self._control: Any = None
         self._receive: Any = None
+        self.messages: list[str] = []
+        self._output = _Output()
 
     def connect(self) -> Measured:
         """Connect RTDE (receive, then control: ur-rtde uploads its control program), arm
@@ -57,14 +64,21 @@ class URArm:
             raise ConfigError(
                 "--arm", f'ur: needs ur-rtde: pip install "articula[ur]" ({exc})'
             ) from None
+        self._output.capture()
         try:
             self._receive = rtde_receive.RTDEReceiveInterface(self.host, self.rate, VARIABLES)
             self._control = rtde_control.RTDEControlInterface(self.host, self.rate)
+            if not self._control.setWatchdog(WATCHDOG_HZ):
+                raise DeviceError(
+                    f"ur:{self.host}: the controller refused setWatchdog ({self._why()})"
+                )
+            return self.read()
         except RuntimeError as exc:
+            self.messages += self._output.release()
             raise DeviceError(f"ur:{self.host}: cannot connect ({exc})") from None
-        if not self._control.setWatchdog(WATCHDOG_HZ):
-            raise DeviceError(f"ur:{self.host}: the controller refused setWatchdog ({self._why()})")
-        return self.read()
+        except BaseException:
+            self.messages += self._output.release()
+            raise
 
     def read(self) -> Measured:
         """The latest RTDE state.
@@ -108,10 +122,13 @@ class URArm:
             raise DeviceError(f"ur:{self.host}: stopping failed ({exc})") from None
 
     def close(self) -> None:
-        """Disconnect both interfaces."""
-        for interface in (self._control, self._receive):
-            if interface is not None:
-                interface.disconnect()
+        """Disconnect both interfaces; the client's output is the terminal's again."""
+        try:
+            for interface in (self._control, self._receive):
+                if interface is not None:
+                    interface.disconnect()
+        finally:
+            self.messages += self._output.release()
 
     def _why(self) -> str:
         """What the controller's state says about a refusal."""
@@ -122,3 +139,45 @@ class URArm:
         if int(self._receive.getRuntimeState()) != PLAYING:
             return "its program is not running"
         return "no reason given"
+
+
+class _Output:
+    """File descriptors 1 and 2 sent to a temporary file while capturing, Python's own
+    sys.stdout and sys.stderr kept on the terminal: only what the C++ client writes (its
+    reconnect attempts and exceptions, as many lines as it likes) is captured."""
+
+    def __init__(self) -> None:
+        self._saved: list[tuple[int, int, Any]] = []  # (fd, its copy, Python's stream)
+        self._file: Any = None
+
+    def capture(self) -> None:
+        if self._saved:
+            return
+        self._file = tempfile.TemporaryFile()  # noqa: SIM115  (closed by release)
+        for fd, name in ((1, "stdout"), (2, "stderr")):
+            stream = getattr(sys, name)
+            stream.flush()
+            copy = os.dup(fd)
+            self._saved.append((fd, copy, stream))
+            os.dup2(self._file.fileno(), fd)
+            setattr(sys, name, open(os.dup(copy), "w", buffering=1, closefd=True))  # noqa: SIM115
+
+    def release(self) -> list[str]:
+        """Stop capturing.
+
+        Returns:
+            The lines the client wrote meanwhile.
+        """
+        if not self._saved:
+            return []
+        for fd, copy, stream in self._saved:
+            name = "stdout" if fd == 1 else "stderr"
+            getattr(sys, name).close()
+            setattr(sys, name, stream)
+            os.dup2(copy, fd)
+            os.close(copy)
+        self._saved.clear()
+        self._file.seek(0)
+        lines = self._file.read().decode("utf-8", "replace").splitlines()
+        self._file.close()
+        return [line for line in lines if line.strip()]

@@ -132,7 +132,8 @@ def write_drive(
     trace = run.trace()
     details = {
         "drive": {"arm": run.options.arm, "rate_hz": run.options.rate, "outcome": outcome,
-                  "start_tolerance": run.options.tolerance}
+                  "start_tolerance": run.options.tolerance,
+                  "client_messages": list(getattr(run.loop.arm, "messages", []))}
     }  # fmt: skip
     result = Result(run.metrics(trace), trace, details=details)
     record = records.build_record(config, result, wall_time)
