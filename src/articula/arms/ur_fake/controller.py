@@ -109,21 +109,46 @@ class Controller:
     # -- what the program reads and does (program.Registers) --------------------------------
 
     def input_int(self, index: int) -> int:
-        """input_int_register_{index}."""
+        """input_int_register_{index}.
+
+        Args:
+            index: the register's number (0–47).
+
+        Returns:
+            Its value.
+        """
         return int(self._inputs[f"input_int_register_{index}"])  # type: ignore[call-overload]
 
     def input_double(self, index: int) -> float:
-        """input_double_register_{index}."""
+        """input_double_register_{index}.
+
+        Args:
+            index: the register's number (0–47).
+
+        Returns:
+            Its value.
+        """
         return float(self._inputs[f"input_double_register_{index}"])  # type: ignore[arg-type]
 
     def set_output_int(self, index: int, value: int) -> None:
-        """Write output_int_register_{index}."""
+        """Write output_int_register_{index}.
+
+        Args:
+            index: the register's number (0–47).
+            value: its new value.
+        """
         self._outputs[f"output_int_register_{index}"] = int(value)
 
     def servoj(self, q: list[float], t: float, lookahead_time: float, gain: float) -> None:
-        """Servo toward q [rad] (t [s], the call's blocking time, is one cycle here);
-        lookahead_time [s] and gain are checked within servoj's ranges (a value outside stops
-        the program, as a runtime error)."""
+        """Servo toward q; lookahead_time and gain are checked within servoj's ranges (a
+        value outside stops the program, as a runtime error).
+
+        Args:
+            q: the target joints, six values [rad].
+            t: the call's blocking time [s] (one cycle here).
+            lookahead_time: servoj's smoothing time [s] (the follower's time constant).
+            gain: servoj's proportional gain (checked, not used).
+        """
         if not LOOKAHEAD[0] <= lookahead_time <= LOOKAHEAD[1] or not GAIN[0] <= gain <= GAIN[1]:
             self._stop_program(
                 f"servoj: lookahead_time {lookahead_time:g} s or gain {gain:g} outside "
@@ -133,19 +158,32 @@ class Controller:
         self._servo = (np.array(q, dtype=float), lookahead_time)
 
     def brake(self, why: str) -> None:
-        """Stop servoing and bring the arm to rest."""
+        """Stop servoing and bring the arm to rest.
+
+        Args:
+            why: what asked for it, for the log.
+        """
         if self._servo is not None or np.any(self.qd_cmd):
             self._event(f"{why}: braking")
         self._servo, self._braking = None, True
 
     def set_watchdog(self, register: str, frequency: float) -> None:
-        """Stop the program when `register` is not written at least at `frequency` [Hz]."""
+        """Stop the program when `register` is not written at least at `frequency`.
+
+        Args:
+            register: the watched input variable's name.
+            frequency: the least rate it must be written at [Hz].
+        """
         self._watchdog = (register, frequency)
         self._written[register] = self.t
         self._event(f"RTDE watchdog on {register} at {frequency:g} Hz")
 
     def protective_stop(self, why: str) -> None:
-        """Brake, pause the program, flag the protective stop."""
+        """Brake, pause the program, flag the protective stop.
+
+        Args:
+            why: the cause, for the log.
+        """
         self.protective = True
         self._servo, self._braking = None, True
         if self.runtime_state == PLAYING:
@@ -155,14 +193,23 @@ class Controller:
     # -- what the network side does ---------------------------------------------------------
 
     def write_inputs(self, values: dict[str, object]) -> None:
-        """A client's data package: its registers' new values (under the lock)."""
+        """A client's data package: its variables' new values (call it holding the lock).
+
+        Args:
+            values: input variable name -> its value.
+        """
         self._inputs.update(values)
         for name in values:
             self._written[name] = self.t
 
     def run_program(self, program: ControlProgram | None, name: str) -> None:
-        """A program arrived on the script port: the running one stops, this one plays
-        (None: a program the fake cannot run, which it says and ignores)."""
+        """A program arrived on a script port: the running one stops, this one plays.
+
+        Args:
+            program: ur-rtde's control program, or None for one the fake cannot run (which
+                it says and ignores).
+            name: the program's name (`def name():`), for the log.
+        """
         if self.runtime_state != STOPPED:
             self._stop_program("a new program replaces it")
         if program is None:
@@ -177,7 +224,11 @@ class Controller:
         self._event(f"program {name!r} playing")
 
     def stop_program(self, why: str) -> None:
-        """Stop the program (the dashboard's `stop`)."""
+        """Stop the program and brake (the dashboard's `stop`).
+
+        Args:
+            why: what asked for it, for the log.
+        """
         self._stop_program(why)
 
     def unlock_protective_stop(self) -> None:

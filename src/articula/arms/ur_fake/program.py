@@ -35,31 +35,71 @@ class Registers(Protocol):
     """What the program needs of the controller it runs on."""
 
     def input_int(self, index: int) -> int:
-        """input_int_register_{index}."""
+        """input_int_register_{index}.
+
+        Args:
+            index: the register's number (0–47).
+
+        Returns:
+            Its value.
+        """
         ...
 
     def input_double(self, index: int) -> float:
-        """input_double_register_{index}."""
+        """input_double_register_{index}.
+
+        Args:
+            index: the register's number (0–47).
+
+        Returns:
+            Its value.
+        """
         ...
 
     def set_output_int(self, index: int, value: int) -> None:
-        """Write output_int_register_{index}."""
+        """Write output_int_register_{index}.
+
+        Args:
+            index: the register's number (0–47).
+            value: its new value.
+        """
         ...
 
     def servoj(self, q: list[float], t: float, lookahead_time: float, gain: float) -> None:
-        """Servo toward q, reached in t [s]."""
+        """Servo toward q; lookahead_time and gain are checked within servoj's ranges (a
+        value outside stops the program, as a runtime error).
+
+        Args:
+            q: the target joints, six values [rad].
+            t: the call's blocking time [s] (one cycle here).
+            lookahead_time: servoj's smoothing time [s] (the follower's time constant).
+            gain: servoj's proportional gain (checked, not used).
+        """
         ...
 
     def brake(self, why: str) -> None:
-        """Bring the arm to rest."""
+        """Stop servoing and bring the arm to rest.
+
+        Args:
+            why: what asked for it, for the log.
+        """
         ...
 
     def set_watchdog(self, register: str, frequency: float) -> None:
-        """Stop the program when `register` is not written at `frequency` [Hz]."""
+        """Stop the program when `register` is not written at least at `frequency`.
+
+        Args:
+            register: the watched input variable's name.
+            frequency: the least rate it must be written at [Hz].
+        """
         ...
 
     def protective_stop(self, why: str) -> None:
-        """Stop the arm and pause the program."""
+        """Brake, pause the program, flag the protective stop.
+
+        Args:
+            why: the cause, for the log.
+        """
         ...
 
 
@@ -82,7 +122,11 @@ class ControlProgram:
         self._executing = False
 
     def start(self, c: Registers) -> None:
-        """The script's first lines: no async operation, ready for a command."""
+        """The script's first lines: no async operation, ready for a command.
+
+        Args:
+            c: the controller.
+        """
         c.set_output_int(self.int_offset + 2, -1)
         c.set_output_int(self.int_offset, READY)
 
