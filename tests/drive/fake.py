@@ -32,12 +32,15 @@ def environment() -> dict[str, str]:
     return {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in paths if p)}
 
 
-def scene_file(folder: Path, duration: float = 4.0, robot: dict | None = None) -> Path:
-    """A UR10 scene (tests.arms) of `duration` [s] written to folder/ur10.toml."""
-    data = arm_scene("ur10", duration)
+def scene_file(
+    folder: Path, duration: float = 4.0, robot: dict | None = None, name: str = "ur10"
+) -> Path:
+    """A UR scene (tests.arms: "ur10" or "ur5") of `duration` [s] written to folder/NAME.toml,
+    its [robot] updated with `robot`."""
+    data = arm_scene(name, duration)
     if robot is not None:
         data["robot"] |= robot
-    path = folder / "ur10.toml"
+    path = folder / f"{name}.toml"
     path.write_text(tomli_w.dumps(data))
     return path
 

@@ -43,7 +43,9 @@ def _wait_until_moving(fake: Fake) -> None:
     receive.disconnect()
 
 
-def test_the_drive_tracks_within_2_mm_and_keeps_every_limit(scene, tmp_path):
+@pytest.mark.parametrize("arm", ["ur10", "ur5"])
+def test_the_drive_tracks_within_2_mm_and_keeps_every_limit(tmp_path, arm):
+    scene = scene_file(tmp_path, name=arm)
     fake = Fake(scene, tmp_path)
     drive = _drive(scene, fake, tmp_path / "run")
     assert drive.process.wait() == 0, drive.lines
@@ -101,7 +103,7 @@ def test_a_signal_mid_motion_brings_the_arm_to_rest_then_stops_the_program(
     drive = _drive(scene, fake, tmp_path / "run")
     drive.wait_for("streaming to")
     _wait_until_moving(fake)
-    assert drive.end(sig) == status
+    assert drive.end(sig) == status, drive.lines
     errors = [line for line in drive.lines if line.startswith("error:")]
     assert len(errors) == 1 and len(drive.lines) == 2, drive.lines  # "streaming", the error
     record = json.loads((tmp_path / "run/record.json").read_text())

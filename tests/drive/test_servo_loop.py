@@ -43,7 +43,7 @@ def test_the_measured_arm_follows_the_stream_and_ends_at_rest(plan):
     for k in range(periods):
         q = controller.step(plan.reference(k * dt), q_measured=loop.latest().q)
         loop.push(q)
-    loop.stop()
+    loop.finish()
     assert loop.braked and not loop.stalled
     ticks = loop.stream.ticks
     assert len(loop.sent) >= periods * ticks  # every set-point's ticks, then the braking path

@@ -7,7 +7,10 @@ jerk-limited stream (loops.servo.ServoStream) and sends them paced by the wall c
 planner's time is off the servo thread, so a slow step does not make a tick late; a set-point
 missing at its period's start is a stall (the planner is more than `ahead` periods behind):
 the loop then plays the stream's braking path, stops the arm and `push` raises StallError.
-`stop` (Ctrl-C, SIGTERM, the run's end) plays the same braking path.
+`finish` (the run's end) plays the queued set-points, then the same braking path; `stop`
+(Ctrl-C, SIGTERM, a failure) plays it at once. The path's end is then held until the
+measured arm, which lags its commands, is at rest too (REST, at most SETTLE), and only then
+is the arm stopped.
 """
 
 from __future__ import annotations
@@ -25,8 +28,10 @@ from articula.robots.model import RobotModel
 
 __all__ = ["AHEAD", "ServoLoop"]
 
-AHEAD = 3  # [periods] how far the planner may run ahead of the stream (its stall bound)
+AHEAD = 5  # [periods] how far the planner may run ahead of the stream (its stall bound)
 PUSH_TIMEOUT = 5.0  # [s] a push that waits longer: the servo thread is wedged (a bug)
+REST = 1e-3  # [rad/s] a measured joint slower than this is at rest
+SETTLE = 1.0  # [s] the longest the braking path's end is held for the measured arm to rest
 
 
 class ServoLoop:
@@ -68,7 +73,7 @@ class ServoLoop:
         self._last = np.array(start.q, dtype=float)  # the last set-point, on the arm's branch
         stream.reset(self._last)
         self._queue: deque[np.ndarray] = deque()
-        self._stop = False
+        self._stop = self._finished = False
         self._cv = threading.Condition()
         self.ended = threading.Event()
         self._thread = threading.Thread(target=self._run, name="servo", daemon=True)
@@ -113,12 +118,24 @@ class ServoLoop:
         ticks = len(self.measured) - 1
         return ticks // self.stream.ticks, self.measured[ticks]
 
+    def finish(self) -> None:
+        """No more set-points: play those queued, then the braking path, and stop the arm;
+        returns when it is done. Raises the arm's failure, if it failed."""
+        with self._cv:
+            self._finished = True
+            self._cv.notify_all()
+        self._join()
+
     def stop(self) -> None:
-        """Play the stream's braking path and stop the arm; returns when it is done (also
-        after a stall or a failure). Raises the arm's failure, if it failed."""
+        """Play the stream's braking path from where it is now (the queued set-points are
+        dropped) and stop the arm; returns when it is done (also after a stall or a failure).
+        Raises the arm's failure, if it failed."""
         with self._cv:
             self._stop = True
             self._cv.notify_all()
+        self._join()
+
+    def _join(self) -> None:
         self._thread.join()
         if self.error is not None:
             raise DeviceError(f"the arm failed: {self.error}") from self.error
@@ -135,7 +152,7 @@ class ServoLoop:
                 f"the planner fell more than {self._ahead} periods of "
                 f"{1e3 * self.stream.dt:g} ms behind the stream: the arm was brought to rest"
             )
-        if self._stop or not self._thread.is_alive():
+        if self._stop or self._finished or not self._thread.is_alive():
             raise StallError("the servo loop has stopped")
 
     def _run(self) -> None:
@@ -143,17 +160,24 @@ class ServoLoop:
         the braking path when they run out or stop() is asked."""
         try:
             with self._cv:
-                self._cv.wait_for(lambda: len(self._queue) >= self._ahead or self._stop)
+                self._cv.wait_for(
+                    lambda: len(self._queue) >= self._ahead or self._stop or self._finished
+                )
             while True:
                 with self._cv:
                     if self._stop or not self._queue:
-                        self.stalled = not self._stop
+                        self.stalled = not (self._stop or self._finished)
                         break
                     point = self._queue.popleft()
                     self._cv.notify_all()
                 self._play(self.stream.period(point))
-            for point in self.stream.stopping_points():
+            points = self.stream.stopping_points()
+            for point in points:
                 self._play(self.stream.period(point))
+            for _ in range(int(np.ceil(SETTLE / self.stream.dt))):  # the measured arm lags
+                if self._speed() <= REST:
+                    break
+                self._play(self.stream.period(points[-1]))
             self.arm.stop()
             self.braked = True
         except Exception as exc:  # the arm's failure ends the loop; push and stop raise it
@@ -162,6 +186,14 @@ class ServoLoop:
             self.ended.set()
             with self._cv:
                 self._cv.notify_all()
+
+    def _speed(self) -> float:
+        """The largest joint speed between the last two measurements of different times."""
+        last = self.measured[-1]
+        for earlier in reversed(self.measured[:-1]):
+            if earlier.t < last.t:
+                return float(np.max(np.abs(last.q - earlier.q)) / (last.t - earlier.t))
+        return 0.0
 
     def _play(self, samples: np.ndarray) -> None:
         """Send one period's ticks, each at its release, and read the arm back."""

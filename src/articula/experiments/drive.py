@@ -13,8 +13,9 @@ written; then the interruption or failure goes on.
 from __future__ import annotations
 
 import contextlib
+import signal
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -34,6 +35,7 @@ from articula.signals import Terminated
 __all__ = ["START_TOLERANCE", "DriveOptions", "arm_from_spec", "check_start", "drive"]
 
 START_TOLERANCE = 0.05  # [rad] the farthest a joint may be from robot.q0 for a drive to start
+SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 
 @dataclass(frozen=True)
@@ -166,25 +168,57 @@ def drive(
     started = time.monotonic()
     announce(f"streaming to {options.arm} at {options.rate:g} Hz for {periods * dt:g} s")
     failure: BaseException | None = None
-    try:
-        for k in range(periods):
-            played, measured = loop.measurement()  # it answers the target of period played - 1
-            lag = min(max(k - played, 0), MAX_LAG)
-            q = controller.step(plan.reference(k * dt), q_measured=robot.wrap(measured.q), lag=lag)
-            loop.push(q)
-            run.setpoints.append(q)
-    except (KeyboardInterrupt, Terminated, ArticulaError) as exc:
-        failure = exc
-    try:
-        loop.stop()
-    except DeviceError as exc:
-        failure = failure or exc
-    with contextlib.suppress(RuntimeError):  # a controller that is gone has nothing to close
-        arm.close()
+    with _signals_noted() as signals:  # raised between periods, never inside a kernel
+        try:
+            for k in range(periods):
+                if signals:
+                    raise _as_exception(signals[0])
+                played, measured = loop.measurement()  # it answers period played - 1's target
+                lag = min(max(k - played, 0), MAX_LAG)
+                q = controller.step(
+                    plan.reference(k * dt), q_measured=robot.wrap(measured.q), lag=lag
+                )
+                loop.push(q)
+                run.setpoints.append(q)
+        except (KeyboardInterrupt, Terminated, ArticulaError) as exc:
+            failure = exc
+        try:
+            if failure is None:
+                loop.finish()  # the queued set-points, then the braking path
+            else:
+                loop.stop()  # the braking path from where the stream is
+        except DeviceError as exc:
+            failure = failure or exc
+        with contextlib.suppress(RuntimeError):  # a controller that is gone has nothing to close
+            arm.close()
+        if failure is None and signals:  # a signal during the braking path: it was not cut
+            failure = _as_exception(signals[0])
     record = write_drive(out, data, run, _outcome(failure), time.monotonic() - started, force)
     if failure is not None:
         raise failure
     return record
+
+
+@contextlib.contextmanager
+def _signals_noted() -> Iterator[list[int]]:
+    """Within the block, SIGINT and SIGTERM are noted, not raised: a signal raised inside a
+    compiled kernel would surface as a SystemError, and the braking path must not be cut.
+
+    Yields:
+        The signals received so far (the list grows).
+    """
+    noted: list[int] = []
+    previous = {s: signal.signal(s, lambda n, _: noted.append(n)) for s in SIGNALS}
+    try:
+        yield noted
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+
+
+def _as_exception(signum: int) -> BaseException:
+    """What the CLI makes of a signal: Ctrl-C (130) or SIGTERM (143)."""
+    return KeyboardInterrupt() if signum == signal.SIGINT else Terminated()
 
 
 def _outcome(failure: BaseException | None) -> str:

@@ -150,9 +150,9 @@ class FakeUR:
         """The controller's 2 ms cycle, paced by the wall clock (late cycles catch up)."""
         pacer, cycle = Pacer(1.0 / RATE), 0
         while not self._stop.is_set():
-            pacer.wait()
+            late = pacer.wait()
             with self.controller.lock:
-                values = self.controller.tick()
+                values = self.controller.tick(on_time=late < pacer.period)
                 packages = list(self._sessions)
                 for session in packages:
                     session.publish(cycle, values)
