@@ -9,6 +9,7 @@ seconds after its approach, the planner at 10 ms, servoJ at 500 Hz:
   deadline_miss_fraction  servo ticks released a whole tick (2 ms) or more late, of all
   latency_p99_ms          the ticks' lateness, 99th percentile [ms] (and _p50, _max)
   tracking_rms_mm         the measured tool from its reference once settled, RMS [mm]
+  planner_step_p99_ms     the planner's wall time a 10 ms period, 99th percentile [ms]
   contacts                cycles in which the fake's twin saw a contact
 Targets (issue 44, on an idle machine): deadline_miss_fraction 0, tracking_rms_mm ≤ 2,
 contacts 0. The fake and the drive share the machine's cores: a busy machine misses more.
@@ -79,6 +80,7 @@ def measure(duration: float) -> dict[str, float]:
         "latency_p99_ms": m["servo_latency_p99_ms"],
         "latency_max_ms": m["servo_latency_max_ms"],
         "tracking_rms_mm": 1e3 * m["plant_rms_error"],
+        "planner_step_p99_ms": m["planner_step_p99_ms"],
         "contacts": float((contacts > 0).sum()),
         "ticks": m["servo_releases"],
     }

@@ -28,7 +28,7 @@ from articula.robots.model import RobotModel
 
 __all__ = ["AHEAD", "ServoLoop"]
 
-AHEAD = 5  # [periods] how far the planner may run ahead of the stream (its stall bound)
+AHEAD = 10  # [periods] how far the planner may run ahead of the stream (its stall bound)
 PUSH_TIMEOUT = 5.0  # [s] a push that waits longer: the servo thread is wedged (a bug)
 REST = 1e-3  # [rad/s] a measured joint slower than this is at rest
 SETTLE = 1.0  # [s] the longest the braking path's end is held for the measured arm to rest
@@ -65,7 +65,9 @@ class ServoLoop:
         if ahead < 1:
             raise ConfigError("ahead", f"must be ≥ 1 period (got {ahead})")
         self.arm, self.stream, self._robot, self._ahead = arm, stream, robot, ahead
-        self.pacer = Pacer(stream.dt / stream.ticks)
+        # A late tick restarts the schedule: a starved thread never sends ticks in a burst
+        # (the stream slows rather than jumps; the lateness is still counted).
+        self.pacer = Pacer(stream.dt / stream.ticks, catch_up=False)
         self.measured: list[Measured] = [start]
         self.sent: list[np.ndarray] = []
         self.stalled = self.braked = False

@@ -175,9 +175,11 @@ def drive(
                     raise _as_exception(signals[0])
                 played, measured = loop.measurement()  # it answers period played - 1's target
                 lag = min(max(k - played, 0), MAX_LAG)
+                began = time.perf_counter()
                 q = controller.step(
                     plan.reference(k * dt), q_measured=robot.wrap(measured.q), lag=lag
                 )
+                run.step_s.append(time.perf_counter() - began)
                 loop.push(q)
                 run.setpoints.append(q)
         except (KeyboardInterrupt, Terminated, ArticulaError) as exc:

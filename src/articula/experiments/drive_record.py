@@ -33,6 +33,7 @@ class DriveRun:
         loop: the servo loop (its measurements and lateness).
         offset: how far each joint started from robot.q0, shape (n,) [rad].
         setpoints: the planner's set-point of each period, (n,) [rad] each.
+        step_s: the wall time of each period's planner step [s].
     """
 
     plan: PlanSetup
@@ -40,6 +41,7 @@ class DriveRun:
     loop: ServoLoop
     offset: np.ndarray
     setpoints: list[np.ndarray] = field(default_factory=list)
+    step_s: list[float] = field(default_factory=list)
 
     def trace(self) -> dict[str, np.ndarray]:
         """One row per period streamed: t [s], q_j (set-points) and qm_j (measured at the
@@ -75,7 +77,8 @@ class DriveRun:
             plant_rms_error, plant_max_error (the measured tool from its reference once
             settled, planner.settle into the path [m]); the servo loop's servo_releases,
             servo_deadline_misses, servo_deadline_miss_fraction, servo_latency_p50_ms,
-            _p99_ms, _max_ms; measured_max_velocity_ratio and
+            _p99_ms, _max_ms; planner_step_p50_ms, _p99_ms, _max_ms (the planner's wall
+            time a period [ms]); measured_max_velocity_ratio and
             measured_max_acceleration_ratio (differences of the measured joints at the
             arm's own timestamps, over the limits); plant_final_speed [rad/s]; the measured
             arm's clearances (plant_min_clearance, ... of loops.sampled_clearance).
@@ -91,6 +94,10 @@ class DriveRun:
             "plant_max_error": float(np.max(error)) if error.size else None,
         }
         metrics |= loop.pacer.latency().as_metrics("servo")
+        if self.step_s:
+            p50, p99 = np.percentile(self.step_s, [50, 99])
+            metrics |= {"planner_step_p50_ms": 1e3 * p50, "planner_step_p99_ms": 1e3 * p99,
+                        "planner_step_max_ms": 1e3 * max(self.step_s)}  # fmt: skip
         t = np.array([m.t for m in loop.measured])
         q = np.array([m.q for m in loop.measured])
         fresh = np.concatenate([[True], np.diff(t) > 0])  # a read within one controller cycle
