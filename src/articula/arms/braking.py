@@ -7,7 +7,26 @@ from collections.abc import Iterator
 
 import numpy as np
 
-__all__ = ["braking_ticks"]
+__all__ = ["brake_step", "braking_ticks"]
+
+
+def brake_step(
+    q: np.ndarray, qd: np.ndarray, deceleration: np.ndarray, h: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """One tick of braking.
+
+    Args:
+        q: the joints where the motion is, shape (n,) [rad].
+        qd: their velocities, shape (n,) [rad/s].
+        deceleration: each joint's deceleration, shape (n,) [rad/s²] (> 0).
+        h: the tick [s].
+
+    Returns:
+        The joints [rad] and velocities [rad/s] a tick later.
+    """
+    step = np.asarray(deceleration, dtype=float) * h
+    qd = qd - np.clip(qd, -step, step)
+    return q + qd * h, qd
 
 
 def braking_ticks(
@@ -25,8 +44,6 @@ def braking_ticks(
         (q, qd) at each tick until every joint is at rest; the last has qd = 0.
     """
     q, qd = np.array(q, dtype=float), np.array(qd, dtype=float)
-    step = np.asarray(deceleration, dtype=float) * h
     while np.any(qd):
-        qd = qd - np.clip(qd, -step, step)
-        q = q + qd * h
+        q, qd = brake_step(q, qd, deceleration, h)
         yield q.copy(), qd.copy()

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from articula.arms.braking import brake_step
 from articula.arms.ur_fake.program import ControlProgram, NotModelledError
 from articula.arms.ur_fake.rtde_types import FORMATS, INPUTS, OUTPUTS
 from articula.scene.scene import Scene
@@ -271,9 +272,9 @@ class Controller:
         """The commanded motion this cycle: toward servoJ's target, braking, or held."""
         previous = self.qd_cmd
         if self._braking:
-            step = self.robot.acceleration_limit * self.h
-            self.qd_cmd = self.qd_cmd - np.clip(self.qd_cmd, -step, step)
-            self.q_cmd = self.q_cmd + self.qd_cmd * self.h
+            self.q_cmd, self.qd_cmd = brake_step(
+                self.q_cmd, self.qd_cmd, self.robot.acceleration_limit, self.h
+            )
             self._braking = bool(np.any(self.qd_cmd))
         elif self._servo is not None and self.runtime_state == PLAYING:
             target, lookahead = self._servo
