@@ -1,6 +1,6 @@
 """Plan configs of real arms among obstacles, shared by the tests: a Franka Panda (pybullet_data)
-circling past a box, a ball and a mesh (the "Panda tight scene"), a Universal Robots UR10 and a
-Kinova Jaco 2 (example-robot-data) each circling past a ball."""
+circling past a box, a ball and a mesh (the "Panda tight scene"), a Universal Robots UR10 and UR5
+and a Kinova Jaco 2 (example-robot-data) each circling past a ball."""
 
 from __future__ import annotations
 
@@ -46,6 +46,13 @@ def ur10_robot() -> dict:
     return {"urdf": str(urdf), "package_dirs": [str(share)], "q0": UR10_HOME}
 
 
+def ur5_robot() -> dict:
+    """The UR5 (CB3) of example-robot-data (it has no UR5e), at the UR10's home."""
+    share = robot_data()
+    urdf = share / "example-robot-data/robots/ur_description/urdf/ur5_robot.urdf"
+    return {"urdf": str(urdf), "package_dirs": [str(share)], "q0": UR10_HOME}
+
+
 def jaco2_robot(q0: list[float] | None = None) -> dict:
     """The Kinova Jaco 2 (j2s6s200) of example-robot-data, at kinova-ros's home (or `q0`)."""
     share = robot_data()
@@ -56,7 +63,8 @@ def jaco2_robot(q0: list[float] | None = None) -> dict:
 def arm_scene(name: str, duration: float = 12.0) -> dict:
     """A plan config of one arm circling past obstacles, with the [planner] defaults but for
     Λ, d_min and the run's length: "panda" (a box, a ball and a mesh; d_min 5 mm), "xarm6" (a
-    ball and a box), "ur10" (a ball; d_min 20 mm) or "jaco2" (a ball; d_min 10 mm)."""
+    ball and a box), "ur10" (a ball; d_min 20 mm), "ur5" (a ball; d_min 15 mm) or "jaco2" (a
+    ball; d_min 10 mm)."""
     planner = {"lambda_weight": 0.002, "d_min": 0.005, "duration": duration, "settle": 2.0}
     if name == "panda":
         return {"robot": panda_robot(), "planner": planner,
@@ -71,6 +79,11 @@ def arm_scene(name: str, duration: float = 12.0) -> dict:
                 "trajectory": {**CIRCLE, "center": [0.7, 0.16, 0.55], "radius": 0.15},
                 "obstacles": [{"name": "ball", "sphere": 0.06,
                                "position": [0.66, 0.40, 0.66]}]}  # fmt: skip
+    if name == "ur5":  # the UR10's scene scaled to the UR5's reach (≈ 2/3)
+        return {"robot": ur5_robot(), "planner": {**planner, "d_min": 0.015},
+                "trajectory": {**CIRCLE, "center": [0.49, 0.11, 0.37], "radius": 0.07},
+                "obstacles": [{"name": "ball", "sphere": 0.04,
+                               "position": [0.46, 0.27, 0.44]}]}  # fmt: skip
     if name == "jaco2":
         return {"robot": jaco2_robot(), "planner": {**planner, "d_min": 0.01},
                 "trajectory": {**CIRCLE, "center": [0.18, -0.23, 0.40], "radius": 0.06},

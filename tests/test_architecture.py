@@ -32,6 +32,7 @@ LAYERS = {
     "runs": 9,
     "sim": 9,
     "rigs": 10,
+    "arms": 10,
     "identify": 10,
     "experiments": 11,
     "book": 12,

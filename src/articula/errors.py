@@ -63,3 +63,8 @@ class PortError(ArticulaError, ValueError):
     """A rig's serial port cannot be used: it does not exist, nothing on it answers the
     handshake, or the device is another rig or speaks another protocol version (bad input:
     the command line exits with status 2; a rig failing mid-run is a DeviceError)."""
+
+
+class StallError(ResourceError):
+    """A servo loop ran out of set-points (the planner or the sender fell behind its bound):
+    the arm was brought to rest and the run stopped. The command line exits with status 1."""

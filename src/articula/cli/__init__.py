@@ -18,7 +18,19 @@ from typing import NoReturn
 import typer
 from typer.exceptions import Abort, Exit, TyperException
 
-from articula.cli import arm, bench, book, emulate, identify, rig_tune, rigs, runs, scene, viewer  # noqa: F401  (each module adds its commands to app)
+from articula.cli import (  # noqa: F401  (each module adds its commands to app)
+    arm,
+    bench,
+    book,
+    drive,
+    emulate,
+    identify,
+    rig_tune,
+    rigs,
+    runs,
+    scene,
+    viewer,
+)
 from articula.cli.app import app
 from articula.cli.words import speak_in_words
 from articula.errors import ArticulaError, CollisionError, DeviceError, ResourceError

@@ -13,7 +13,7 @@ from articula.cli.app import app, out
 
 @app.command()
 def emulate(
-    rig: Annotated[str, typer.Argument(help="pneunet, six-chamber or motor.")],
+    rig: Annotated[str, typer.Argument(help="pneunet, six-chamber, motor or ur.")],
     realtime: Annotated[
         bool,
         typer.Option(
@@ -42,17 +42,55 @@ def emulate(
             "device."
         ),
     ] = None,
+    scene: Annotated[
+        Path | None, typer.Option(help="ur: the scene file whose arm the controller has.")
+    ] = None,
+    host: Annotated[
+        str, typer.Option(help="ur: the address to listen on (ports 29999, 30001-30004).")
+    ] = "127.0.0.1",
+    start: Annotated[
+        str | None,
+        typer.Option(help="ur: the arm's joints at power-on [rad], comma separated (robot.q0)."),
+    ] = None,
+    log: Annotated[
+        Path | None, typer.Option(help="ur: write the controller's log here (Parquet) at the end.")
+    ] = None,
 ) -> None:
-    """Start a simulated rig behind a pseudo-terminal and print its device path.
+    """Start a simulated bench rig behind a pseudo-terminal and print its device path, or
+    (ur) a fake Universal Robots controller that speaks RTDE, running the scene's arm.
 
-    Point `articula rig info / run / record / tune` at the path it prints.
+    Point `articula rig info / run / record / tune` at the path it prints, or `articula
+    drive SCENE --arm ur:HOST` at the fake's address.
 
     \b
-    Example: articula emulate motor --firmware firmware/build/motor.elf"""
-    from articula.experiments.rig_registry import rig_named
+    Example: articula emulate motor --firmware firmware/build/motor.elf
+    Example: articula emulate ur --scene ur10.toml --host 127.0.0.2"""
     from articula.signals import terminate_as_interrupt
+
+    if rig == "ur":
+        _emulate_ur(scene, host, start, log)
+        return
+    from articula.experiments.rig_registry import rig_named
 
     emulator = rig_named(rig).emulated(plant, firmware, realtime, faults, seed)
     with terminate_as_interrupt(), emulator:  # Ctrl-C or SIGTERM: the rig stops, 130 or 143
         out.print(f"{rig} rig at {emulator.path} (Ctrl-C stops it)")
         threading.Event().wait()
+
+
+def _emulate_ur(scene: Path | None, host: str, start: str | None, log: Path | None) -> None:
+    """Serve the fake UR controller until Ctrl-C (130) or SIGTERM (143)."""
+    from articula.errors import ConfigError
+    from articula.experiments.ur_fake import serve_fake_ur
+    from articula.signals import terminate_as_interrupt
+
+    if scene is None:
+        raise ConfigError("--scene", "emulate ur needs the scene file whose arm it runs")
+    try:
+        joints = None if start is None else [float(v) for v in start.split(",")]
+    except ValueError:
+        raise ConfigError(
+            "--start", f"needs numbers [rad], comma separated (got {start!r})"
+        ) from None
+    with terminate_as_interrupt():
+        serve_fake_ur(scene, host, joints, log, lambda line: out.print(line, soft_wrap=True))

@@ -14,6 +14,7 @@ and a planned run share one code path:
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -27,6 +28,7 @@ from articula.scene.scene import Scene
 
 MAX_LEAD = 0.05  # [m] the largest correction of a target for the tool's lag (anti-windup)
 LEAD_TIME = 1.0  # [s] time constant of that correction: the measured error integrated over it
+MAX_LAG = 16  # [periods] the oldest period a measurement may answer (step's lag)
 
 
 class LivePose:
@@ -101,9 +103,11 @@ class OnlineController:
         self.q: np.ndarray | None = None
         self.q_measured: np.ndarray | None = None
         self.lead = np.zeros(3)
-        self._lead_given = np.zeros(3)  # the lead the last command was planned with
         self.held: Target | None = None  # the start's orientation and tool axis
         self.target: Target | None = None  # the last period's, complete
+        # The planner's tool for each of the last periods' targets (its command's less the lead
+        # it was planned with) [m], newest last.
+        self._intended: deque[np.ndarray] = deque(maxlen=MAX_LAG + 1)
 
     @classmethod
     def from_spec(
@@ -191,6 +195,7 @@ class OnlineController:
             self.planner.follow(moving * self.dt)
         self.q, self.q_measured, self.periods = start, start.copy(), 0
         self.lead, self.target = np.zeros(3), None  # nothing measured against yet
+        self._intended.clear()
         return start.copy()
 
     def step(
@@ -198,6 +203,7 @@ class OnlineController:
         target: Sequence[float] | np.ndarray | Target,
         obstacle_poses: Mapping[str, np.ndarray] | None = None,
         q_measured: Sequence[float] | np.ndarray | None = None,
+        lag: int = 0,
     ) -> np.ndarray:
         """One control period toward the target; obstacle_poses moves live obstacles first.
 
@@ -216,6 +222,9 @@ class OnlineController:
                 moves.
             q_measured: the arm's joint positions measured at the start of the period, shape
                 (n,) [rad]; None: the lag found last (none before any measurement) stays.
+            lag: how many periods before the last one q_measured was taken (a pipelined loop
+                plans ahead of the arm: its measurement answers an older period's target);
+                0 to MAX_LAG.
 
         Returns:
             The new joint positions to send to the arm, shape (n,) [rad] (continuous joints
@@ -238,20 +247,22 @@ class OnlineController:
                 raise ConfigError(f"obstacle_poses.{name}", str(exc)) from None
         if measured is not None:
             self.q_measured = measured
-            if self.target is not None:  # the arm measured aims at the last period's command
-                # Its lag behind the tool the planner chose for the last target (the command's
+            if not 0 <= lag <= MAX_LAG:
+                raise ConfigError("lag", f"must be within [0, {MAX_LAG}] periods (got {lag})")
+            if len(self._intended) > lag:  # the command the measured arm aims at
+                # Its lag behind the tool the planner chose for that target (the command's
                 # less the lead it was given), not behind the target: a deviation the planner
                 # chose (clearance before the path, Eq. 1.11) integrated here winds the lead
                 # up against it, and the loop drifted off the path (docs/deviations.md).
-                intended = robot.ee_position(self.q) - self._lead_given
-                error = intended - robot.ee_position(measured)
+                error = self._intended[-1 - lag] - robot.ee_position(measured)
                 lead = self.lead + self.dt / LEAD_TIME * error
                 self.lead = lead * min(1.0, MAX_LEAD / max(float(np.linalg.norm(lead)), 1e-12))
         self.target = self._complete(target)
-        led, self._lead_given = self.target, self.lead.copy()
+        led, given = self.target, self.lead.copy()
         if self.lead.any():
             led = Target(self.target.position + self.lead, self.target.rotation, self.target.axis)
         self.q = robot.wrap(self.planner.step(self.q, led, self.t))
+        self._intended.append(robot.ee_position(self.q) - given)
         self.periods += 1
         return self.q.copy()
 

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 import viser
 
+from articula.arms.pacing import Pacer
 from articula.errors import ArticulaError
 from articula.loops.online import OnlineController
 from articula.planning.config import (
@@ -353,14 +354,10 @@ def run_live(
             live = Live(server, loaded)
             live.period()  # the loop runs before the URL goes out: a record is never empty
             announce(f"http://{host}:{port}")
-            next_period = time.perf_counter()
+            pacer = Pacer(live.dt, catch_up=False)  # late: the next period starts now
+            pacer.wait()  # the first release: the period above was it
             while True:
-                next_period += live.dt
-                pause = next_period - time.perf_counter()
-                if pause > 0:
-                    time.sleep(pause)
-                else:
-                    next_period = time.perf_counter()  # late: start the next period now
+                pacer.wait()
                 live.period()
         except (KeyboardInterrupt, Terminated):  # Ctrl-C or SIGTERM: the session is written
             interrupted = True
