@@ -1,9 +1,15 @@
 """The fake UR controller as the tests run it: `articula emulate ur` in a process of its own
 (ur-rtde's client holds the GIL while it connects, so the fake cannot share the test's
-process), each on a loopback address of its own, its lines read as they come."""
+process), each on a loopback address of its own, its lines read as they come.
+
+Where the machine allows real-time scheduling (root or CAP_SYS_NICE), the fake plays its
+cycle and the drives stream under SCHED_FIFO (`--rt-priority`, arms.realtime), as a
+controller and a servo host do: other work on a loaded machine then cannot starve the stream
+past the controller's 100 ms watchdog. Elsewhere they run as ordinary processes."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import random
 import re
@@ -12,7 +18,8 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from functools import cache
 from pathlib import Path
 from typing import ClassVar
 
@@ -20,10 +27,41 @@ import numpy as np
 import pyarrow.parquet as pq
 import tomli_w
 
+from articula.arms.realtime import use_realtime
 from tests.arms import arm_scene
 
 HANG = 120.0  # [s] a wait this long means the fake hangs (a guard, not a measurement)
 ROOT = Path(__file__).resolve().parents[2]
+FAKE_PRIORITY, DRIVE_PRIORITY = 20, 10  # SCHED_FIFO: the controller's cycle above the stream
+
+
+@cache
+def realtime_allowed() -> bool:
+    """Whether processes here may use SCHED_FIFO (asked of a child process)."""
+    ask = "import os; os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(1))"
+    child = subprocess.run([sys.executable, "-c", ask], capture_output=True)
+    return child.returncode == 0
+
+
+def rt_options(priority: int) -> list[str]:
+    """`--rt-priority priority` where the machine allows it, else nothing."""
+    return ["--rt-priority", str(priority)] if realtime_allowed() else []
+
+
+@contextlib.contextmanager
+def realtime_here(priority: int = DRIVE_PRIORITY) -> Iterator[None]:
+    """This test process under SCHED_FIFO within the block (where allowed), for a servo
+    stream sent from the test itself; ordinary scheduling again after it."""
+    if not realtime_allowed():
+        yield
+        return
+    use_realtime(priority)
+    try:
+        yield
+    finally:
+        for task in Path("/proc/self/task").iterdir():
+            with contextlib.suppress(ProcessLookupError):
+                os.sched_setscheduler(int(task.name), os.SCHED_OTHER, os.sched_param(0))
 
 
 def environment() -> dict[str, str]:
@@ -120,7 +158,7 @@ class Fake(Process):
         self.host = f"127.{rng.randint(1, 254)}.{rng.randint(1, 254)}.{rng.randint(1, 254)}"
         self.log_path = folder / f"fake-{self.host}.parquet"
         args = ["emulate", "ur", "--scene", str(scene), "--host", self.host]
-        args += ["--log", str(self.log_path)]
+        args += ["--log", str(self.log_path), *rt_options(FAKE_PRIORITY)]
         if start is not None:
             args += ["--start", ",".join(repr(v) for v in start)]
         super().__init__(*args)

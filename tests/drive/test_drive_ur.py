@@ -15,7 +15,7 @@ import pytest
 
 from articula.experiments.plan import build_plan, load_plan
 from tests.arms import UR10_HOME, ur10_robot
-from tests.drive.fake import Fake, Process, joints, scene_file, until
+from tests.drive.fake import DRIVE_PRIORITY, Fake, Process, joints, rt_options, scene_file, until
 
 rtde_receive = pytest.importorskip("rtde_receive", reason='needs ur-rtde: pip install ".[ur]"')
 pytest.importorskip("mujoco", reason='the fake runs the twin: pip install ".[sim]"')
@@ -29,7 +29,8 @@ def scene(tmp_path_factory):
 
 
 def _drive(scene: Path, fake: Fake, out: Path) -> Process:
-    return Process("drive", str(scene), "--arm", f"ur:{fake.host}", "--out", str(out))
+    args = ["drive", str(scene), "--arm", f"ur:{fake.host}", "--out", str(out)]
+    return Process(*args, *rt_options(DRIVE_PRIORITY))
 
 
 def _robot(scene: Path):

@@ -14,7 +14,7 @@ from articula.arms.ur import URArm
 from articula.errors import StallError
 from articula.experiments.plan import build_plan, load_plan
 from articula.loops.servo import ServoLimits, ServoStream
-from tests.drive.fake import Fake, joints, scene_file
+from tests.drive.fake import Fake, joints, realtime_here, scene_file
 
 pytest.importorskip("rtde_control", reason='needs ur-rtde: pip install ".[ur]"')
 pytest.importorskip("mujoco", reason='the fake runs the twin: pip install ".[sim]"')
@@ -28,13 +28,14 @@ def test_a_stalled_planner_brings_the_arm_to_rest_and_stops_the_program(tmp_path
     controller = plan.controller()
     fake = Fake(scene, tmp_path)
     arm = URArm(fake.host, 500.0)
-    start = arm.connect()
     robot, dt = plan.scene.robot, plan.spec.dt
-    stream = ServoStream(ServoLimits.of(robot), dt, arm.rate)
-    loop = ServoLoop(arm, stream, robot, start)
-    for k in range(60):  # 0.6 s of the approach, then the planner stalls
-        loop.push(controller.step(plan.reference(k * dt), q_measured=loop.latest().q))
-    loop.ended.wait()
+    with realtime_here():  # a busy machine must not starve the stream before the stall
+        start = arm.connect()
+        stream = ServoStream(ServoLimits.of(robot), dt, arm.rate)
+        loop = ServoLoop(arm, stream, robot, start)
+        for k in range(60):  # 0.6 s of the approach, then the planner stalls
+            loop.push(controller.step(plan.reference(k * dt), q_measured=loop.latest().q))
+        loop.ended.wait()
     assert loop.stalled and loop.braked and loop.error is None
     with pytest.raises(StallError, match="behind the stream"):
         loop.push(controller.q)

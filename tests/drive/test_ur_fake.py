@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from tests.arms import UR10_HOME
-from tests.drive.fake import Fake, joints, scene_file, until
+from tests.drive.fake import Fake, joints, realtime_here, scene_file, until
 
 rtde_control = pytest.importorskip("rtde_control", reason='needs ur-rtde: pip install ".[ur]"')
 rtde_receive = pytest.importorskip("rtde_receive")
@@ -47,11 +47,12 @@ def test_the_real_client_connects_and_its_servoj_stream_moves_the_twin(scene, tm
     q0 = np.array(receive.getActualQ())
     assert q0 == pytest.approx(UR10_HOME, abs=1e-9)
     goal = q0 + np.array([0.2, -0.1, 0.1, 0.0, 0.0, 0.1])
-    assert _stream(control, q0, goal, 500) == 500
-    for _ in range(200):  # the end held while the arm settles
-        period = control.initPeriod()
-        control.servoJ(list(goal), 0.0, 0.0, TICK, LOOKAHEAD, GAIN)
-        control.waitPeriod(period)
+    with realtime_here():
+        assert _stream(control, q0, goal, 500) == 500
+        for _ in range(200):  # the end held while the arm settles
+            period = control.initPeriod()
+            control.servoJ(list(goal), 0.0, 0.0, TICK, LOOKAHEAD, GAIN)
+            control.waitPeriod(period)
     control.servoStop()
     control.stopScript()
     fake.wait_for("program stopped: stopScript")
@@ -99,7 +100,8 @@ def test_the_program_stops_when_the_stream_stops(scene, tmp_path):
     fake.wait_for("program 'rtde_control' playing")
     assert control.setWatchdog(10.0)
     q0 = np.array(receive.getActualQ())
-    assert _stream(control, q0, q0 + 0.05, 100) == 100  # then nothing: a sender that hangs
+    with realtime_here():
+        assert _stream(control, q0, q0 + 0.05, 100) == 100  # then nothing: a sender that hangs
     line = fake.wait_for("program stopped")
     assert "RTDE watchdog: input_int_register_0 not written" in line
     until(lambda: not control.isProgramRunning())

@@ -33,6 +33,14 @@ def drive(
             help="The farthest a joint may start from robot.q0 [rad]; beyond, nothing moves.",
         ),
     ] = 0.05,
+    rt_priority: Annotated[
+        int | None,
+        typer.Option(
+            help="Run under real-time scheduling (SCHED_FIFO) at this priority, 1-99, once "
+            "the planner is built, so that a busy host cannot starve the stream (needs root "
+            "or CAP_SYS_NICE)."
+        ),
+    ] = None,
     force: Force = False,
 ) -> None:
     """Drive an arm along the scene's plan in real time; writes a run folder like plan's.
@@ -47,12 +55,12 @@ def drive(
 
     \b
     Example: articula emulate ur --scene ur10.toml &
-    Example: articula drive ur10.toml --arm ur:127.0.0.1 --out runs/ur10"""
+    Example: articula drive ur10.toml --arm ur:127.0.0.1 --out runs/ur10 --rt-priority 80"""
     from articula.experiments.drive import DriveOptions
     from articula.experiments.drive import drive as run_drive
     from articula.signals import terminate_as_interrupt
 
-    options = DriveOptions(arm, rate, start_tolerance)
+    options = DriveOptions(arm, rate, start_tolerance, rt_priority)
     with terminate_as_interrupt():
         record = run_drive(scene_file, options, out_dir, force, out.print)
     m = record["metrics"]

@@ -55,6 +55,14 @@ def emulate(
     log: Annotated[
         Path | None, typer.Option(help="ur: write the controller's log here (Parquet) at the end.")
     ] = None,
+    rt_priority: Annotated[
+        int | None,
+        typer.Option(
+            help="Play the rig's (or controller's) cycle under real-time scheduling "
+            "(SCHED_FIFO) at this priority, 1-99, as a controller does (needs root or "
+            "CAP_SYS_NICE)."
+        ),
+    ] = None,
 ) -> None:
     """Start a simulated bench rig behind a pseudo-terminal and print its device path, or
     (ur) a fake Universal Robots controller that speaks RTDE, running the scene's arm.
@@ -67,6 +75,10 @@ def emulate(
     Example: articula emulate ur --scene ur10.toml --host 127.0.0.2"""
     from articula.signals import terminate_as_interrupt
 
+    if rt_priority is not None:  # before any thread starts: they inherit it
+        from articula.arms.realtime import use_realtime
+
+        use_realtime(rt_priority)
     if rig == "ur":
         _emulate_ur(scene, host, start, log)
         return

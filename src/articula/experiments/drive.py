@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from articula.arms.arm import Arm
+from articula.arms.realtime import use_realtime
 from articula.arms.servo_loop import ServoLoop
 from articula.errors import ArticulaError, ConfigError, DeviceError
 from articula.experiments.drive_record import DriveRun, write_drive
@@ -46,11 +47,14 @@ class DriveOptions:
         arm: "ur:HOST" (a UR through ur-rtde) or "twin" (the MuJoCo twin in this process).
         rate: the servo rate [Hz] (500 for a UR e-Series).
         tolerance: the farthest a joint may start from robot.q0 [rad].
+        rt_priority: run the process under SCHED_FIFO at this priority once the planner is
+            built (arms.realtime); None: ordinary scheduling.
     """
 
     arm: str
     rate: float = 500.0
     tolerance: float = START_TOLERANCE
+    rt_priority: int | None = None
 
 
 def arm_from_spec(spec: str, rate: float, plan: PlanSetup) -> Arm:
@@ -148,6 +152,8 @@ def drive(
         raise ConfigError("--rate", exc.problem) from None
     check_out(out, "run", force)
     controller = plan.controller()  # its kernels compiled before the arm's watchdog runs
+    if options.rt_priority is not None:  # after the compiling: a real-time compiler hogs a core
+        use_realtime(options.rt_priority)
     arm = arm_from_spec(options.arm, options.rate, plan)
     start = arm.connect()
     try:

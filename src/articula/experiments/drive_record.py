@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from articula.arms.realtime import scheduling
 from articula.arms.servo_loop import ServoLoop
 from articula.experiments.plan import PlanSetup
 from articula.loops.sampled_clearance import sampled_clearance
@@ -139,7 +140,7 @@ def write_drive(
     trace = run.trace()
     details = {
         "drive": {"arm": run.options.arm, "rate_hz": run.options.rate, "outcome": outcome,
-                  "start_tolerance": run.options.tolerance,
+                  "start_tolerance": run.options.tolerance, "scheduling": scheduling(),
                   "client_messages": list(getattr(run.loop.arm, "messages", []))}
     }  # fmt: skip
     result = Result(run.metrics(trace), trace, details=details)
