@@ -1,6 +1,6 @@
 """A drive of a UR10 against the fake UR controller: deadline misses, lateness, tracking.
 
-    python benchmarks/drive.py [--json] [--duration S]
+    python benchmarks/drive.py [--json] [--duration S] [--rt-priority N]
 
 `articula emulate ur` (the fake controller, the MuJoCo twin inside) and `articula drive --arm
 ur:HOST` run as two processes on this machine, ur-rtde's real client between them: the UR10
@@ -13,6 +13,8 @@ seconds after its approach, the planner at 10 ms, servoJ at 500 Hz:
   contacts                cycles in which the fake's twin saw a contact
 Targets (issue 44, on an idle machine): deadline_miss_fraction 0, tracking_rms_mm ≤ 2,
 contacts 0. The fake and the drive share the machine's cores: a busy machine misses more.
+With --rt-priority N (needs root or CAP_SYS_NICE) a second lane runs the drive at SCHED_FIFO
+priority N and the fake at N + 10, the two lanes in random order; its keys are prefixed rt_.
 """
 
 from __future__ import annotations
@@ -51,7 +53,20 @@ def _scene(folder: Path, duration: float) -> Path:
     return path
 
 
-def measure(duration: float) -> dict[str, float]:
+def measure(duration: float, rt_priority: int) -> dict[str, float]:
+    lanes = [0, rt_priority] if rt_priority else [0]
+    random.SystemRandom().shuffle(lanes)
+    m: dict[str, float] = {}
+    for priority in lanes:
+        prefix = "rt_" if priority else ""
+        m |= {prefix + key: value for key, value in _lane(duration, priority).items()}
+    return m
+
+
+def _lane(duration: float, priority: int) -> dict[str, float]:
+    """One drive against a fake; both under SCHED_FIFO when priority > 0."""
+    fake_rt = ["--rt-priority", str(priority + 10)] if priority else []
+    drive_rt = ["--rt-priority", str(priority)] if priority else []
     rng = random.SystemRandom()
     host = f"127.{rng.randint(1, 254)}.{rng.randint(1, 254)}.{rng.randint(1, 254)}"
     with tempfile.TemporaryDirectory() as tmp:
@@ -59,14 +74,15 @@ def measure(duration: float) -> dict[str, float]:
         scene, log = _scene(folder, duration), folder / "fake.parquet"
         articula = [sys.executable, "-m", "articula"]
         fake = subprocess.Popen(
-            [*articula, "emulate", "ur", "--scene", str(scene), "--host", host, "--log", str(log)],
+            [*articula, "emulate", "ur", "--scene", str(scene), "--host", host, "--log", str(log),
+             *fake_rt],
             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=os.environ,
         )  # fmt: skip
         try:
             fake.stdout.readline()  # "ur controller at ...": it listens
             subprocess.run(
                 [*articula, "drive", str(scene), "--arm", f"ur:{host}", "--out",
-                 str(folder / "run")],
+                 str(folder / "run"), *drive_rt],
                 check=True, stdout=subprocess.DEVNULL,
             )  # fmt: skip
         finally:
@@ -95,5 +111,7 @@ def table(m: dict[str, float]) -> tuple[str, list[str], list[list[str]]]:
 
 
 if __name__ == "__main__":
-    run(__doc__, measure, table, duration={"type": float, "default": 8.0,
-                                           "help": "the path's duration [s]"})  # fmt: skip
+    run(__doc__, measure, table,
+        duration={"type": float, "default": 8.0, "help": "the path's duration [s]"},
+        rt_priority={"type": int, "default": 0,
+                     "help": "a lane under SCHED_FIFO at this priority too (0: none)"})  # fmt: skip
