@@ -11,6 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from scipy.optimize import minimize
 
@@ -34,6 +35,7 @@ from articula.planning.smooth import (
     penalty_gradient,
     smooth_change,
     torque_rows,
+    torques_known,
 )
 from articula.planning.task import Target
 from articula.scene.config import build_scene
@@ -214,6 +216,19 @@ def test_the_torque_rows_are_the_inverse_dynamics_of_the_twin():
         np.testing.assert_allclose(high - low, 2 * TORQUE_SHARE * effort)
         torque = A @ change - (low + high) / 2  # A·Δ + h
         np.testing.assert_allclose(torque, twin.data.qfrc_inverse, rtol=1e-6, atol=1e-6)
+
+
+def test_torques_are_known_only_with_inertias_and_an_effort_limit():
+    config = parse_model(PlanConfig, arm_scene("panda"), "panda")
+    model = build_scene(config, Path("."))[0].robot.model
+    assert torques_known(model)
+    unlimited = model.copy()
+    unlimited.effortLimit[:] = np.inf
+    assert not torques_known(unlimited)
+    massless = model.copy()
+    for k in range(massless.njoints):
+        massless.inertias[k] = pin.Inertia.Zero()
+    assert not torques_known(massless)
 
 
 def test_the_book_circle_stays_on_the_path_under_baornn_improved():

@@ -30,6 +30,7 @@ from articula.planning.smooth import (
     penalty_gradient,
     smooth_change,
     torque_rows,
+    torques_known,
 )
 from articula.planning.task import Target, Task, as_target
 from articula.robots.model import RobotModel
@@ -81,14 +82,15 @@ class BeetleSearch:
     _box: Box | None = field(default=None, init=False, repr=False)  # this period's reach
     _stop: Stop = field(default=NO_STOP, init=False, repr=False)  # its braking check
     _rows: RowSource = field(init=False, repr=False)  # clearance rows and task Jacobian
-    _dynamics: pin.Data = field(init=False, repr=False)  # scratch of the torque rows
+    _dynamics: pin.Data | None = field(init=False, repr=False)  # torque rows' scratch, if any
     # The last command and its motion: the smoothing shapes the commands, which a measured
     # arm (follow) lags.
     _sent: tuple[np.ndarray, np.ndarray] | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
         self._rows = RowSource(self.objective.scene, evaluation=self.objective.evaluation)
-        self._dynamics = self.objective.scene.robot.model.createData()
+        model = self.objective.scene.robot.model
+        self._dynamics = model.createData() if torques_known(model) else None  # once, not a period
 
     def reset(self) -> None:
         """Forget the previous periods: the arm starts at rest."""
@@ -194,13 +196,21 @@ class BeetleSearch:
         change = smooth_change(
             q - coast, motion, scale, A, residual, rows, floors, low, high, push,
             self._error_cap(rows), keep_off,
-            torque_rows(robot.model, self._dynamics, coast - motion, motion / rate.dt, rate.dt),
+            self._torque_rows(coast - motion, motion / rate.dt, rate.dt),
         )  # fmt: skip
         self.evaluations += 1
         if change is None:
             return q, g
         # Refused (outside Ω, or braking from it would leave Ω): the search's point.
         return obj.project_and_value(coast + change, q, g, target, t, self._box, self._stop)
+
+    def _torque_rows(
+        self, q: np.ndarray, velocity: np.ndarray, dt: float
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """The torque rows at the period's end; None where the URDF gives no dynamics."""
+        if self._dynamics is None:
+            return None
+        return torque_rows(self.objective.scene.robot.model, self._dynamics, q, velocity, dt)
 
     def _error_cap(self, rows: ClearanceRows) -> float:
         """How far off the path the smoothing lets g's penalty trade the task for clearance

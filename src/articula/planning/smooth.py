@@ -135,9 +135,22 @@ def _barrier_slope(s: np.ndarray, reach: float, lambda_weight: float, beta: floa
     return np.where(s < reach, slope(s) - slope(reach), 0.0)
 
 
+def torques_known(model: pin.Model) -> bool:
+    """Whether the URDF states what torque_rows needs: inertias and an effort limit.
+
+    Args:
+        model: the arm's Pinocchio model.
+
+    Returns:
+        True where some link has mass and some joint a finite effort limit.
+    """
+    effort = np.asarray(model.effortLimit, dtype=float)
+    return sum(inertia.mass for inertia in model.inertias) > 0 and bool(np.any(np.isfinite(effort)))
+
+
 def torque_rows(
     model: pin.Model, data: pin.Data, q: np.ndarray, velocity: np.ndarray, dt: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The joint torques a period's change of motion Δ asks for, τ = M(q)·Δ/dt² + h(q, q̇)
     (the URDF's inertias; Pinocchio's CRBA and RNEA), as rows kept within ±TORQUE_SHARE of
     the effort limits (beyond the book: a change within the acceleration limits of the
@@ -151,12 +164,10 @@ def torque_rows(
         dt: the control period [s].
 
     Returns:
-        (A [N·m/rad], low, high [N·m]) with low ≤ A·Δ ≤ high; None where the URDF states no
-        inertia or no effort limit (nothing to keep).
+        (A [N·m/rad], low, high [N·m]) with low ≤ A·Δ ≤ high (a joint without an effort limit
+        kept within ±1e30). Meaningful only where torques_known(model).
     """
     effort = TORQUE_SHARE * np.asarray(model.effortLimit, dtype=float)
-    if sum(inertia.mass for inertia in model.inertias) == 0 or not np.any(np.isfinite(effort)):
-        return None
     inertia = pin.crba(model, data, q)
     inertia = np.triu(inertia) + np.triu(inertia, 1).T  # CRBA fills the upper triangle
     bias = pin.rnea(model, data, q, velocity, np.zeros_like(q))
