@@ -61,7 +61,12 @@ def reproduce(
 @motor_app.command("analyze")
 def motor_analyze(
     preset: Annotated[str | None, typer.Option(help="table4.1 or table4.2.")] = None,
-    params: Annotated[Path | None, typer.Option(help="TOML with R, K, b, J, L (SI).")] = None,
+    params: Annotated[
+        Path | None,
+        typer.Option(
+            help="TOML with R, K, b, J, L (SI), or a [motor] table of them (identify's plant.toml)."
+        ),
+    ] = None,
     voltage: Annotated[float, typer.Option(help="Supply voltage V [V].")] = 12.0,
     torque: Annotated[float, typer.Option(help="External torque τ_ex [N·m].")] = 0.0,
     current: Annotated[float, typer.Option(help="Current for ω_c [A].")] = 1.0,

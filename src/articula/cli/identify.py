@@ -22,7 +22,9 @@ Window = Annotated[
 
 @app.command()
 def identify(
-    rig: Annotated[str, typer.Argument(help="The rig whose model to fit: motor or pneunet.")],
+    rig: Annotated[
+        str, typer.Argument(help="The rig whose model to fit: motor, pneunet or six-chamber.")
+    ],
     recordings: Annotated[
         list[Path], typer.Argument(help="Run folders of the rig (rig record / run / identify).")
     ],

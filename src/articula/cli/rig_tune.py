@@ -38,7 +38,8 @@ def tune(
     as_json: JsonFlag = False,
 ) -> None:
     """Tune the PneuNet rig's PID with chapter 2's tuners, one experiment on the rig per
-    probe (counted live); writes tuning.json.
+    probe (counted live); writes tuning.json and tuned.toml (a pneunet.pid config of the
+    tuned gains, with the fitted plant of --model, for `rig run` and `run`).
 
     \b
     Example: articula rig tune /dev/ttyACM0 --method descent --levels 30,60 --out runs/tuning
@@ -60,4 +61,5 @@ def tune(
     out.print(
         f"{method}: K_p = {kp:.4g}, K_i = {ki:.4g}, K_d = {kd:.4g}{cost} after "
         f"{result['experiments']} experiments on the rig{on_model}; in {out_dir / 'tuning.json'}"
+        f" and {out_dir / result['tuned']} (rig run PORT / run take it)"
     )

@@ -56,22 +56,28 @@ def run_(
 ) -> None:
     """Run an experiment config on the rig; the run folder is written as samples arrive.
 
-    A `rig record` folder's config.toml (experiment "rig.record") runs again with the settings
-    it recorded.
+    The same config is then simulated (its [plant]: `identify`'s plant.toml, or the one `rig
+    tune --model` wrote into tuned.toml) and the rig's metrics are shown beside the model's
+    (--json: under model_metrics). A `rig record` folder's config.toml (experiment
+    "rig.record") runs again with the settings it recorded.
 
     \b
-    Example: articula rig run /dev/ttyACM0 my_pid.toml --out runs/rig"""
+    Example: articula rig run /dev/ttyACM0 runs/tuning/tuned.toml --out runs/rig"""
     from articula.experiments.rig_sessions import run_config
 
     record = run_config(port, config, out_dir, force)
+    model = None if record["experiment"] == "rig.record" else _on_the_model(config)
     if as_json:
-        emit_json(record)
+        emit_json(record if model is None else record | {"model_metrics": model})
         return
-    if record["experiment"] == "rig.record":
+    if model is None:
         out.print(f"{record['samples']} samples as recorded in {config} in {out_dir}")
         return
+    rig_rows, model_rows = dict(metric_rows(record["metrics"])), dict(metric_rows(model))
     print_table(
-        f"{record['experiment']} on {port}", ("metric", "value"), metric_rows(record["metrics"])
+        f"{record['experiment']} on {port} and on its model ([plant] of {config.name})",
+        ("metric", "rig", "model"),
+        [(k, rig_rows.get(k, "—"), model_rows.get(k, "—")) for k in rig_rows | model_rows],
     )
     lost = record["link"]
     out.print(
@@ -103,3 +109,13 @@ def record(
         emit_json(summary)
         return
     out.print(f"{summary['samples']} samples of {', '.join(summary['channels'])} in {out_dir}")
+
+
+def _on_the_model(config: Path) -> dict[str, float | str | None]:
+    """The config's metrics simulated in this process (no folder written)."""
+    from articula.runs.registry import with_absolute_paths
+    from articula.runs.runner import execute
+    from articula.validation import load_toml
+
+    data = with_absolute_paths(load_toml(config), config.parent)
+    return execute(data, where=str(config)).record["metrics"]

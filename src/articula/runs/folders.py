@@ -32,12 +32,13 @@ SUMMARY = "summary.json"
 SUITE_FILES = frozenset({RESULTS, SUMMARY})  # and the problems/ folder
 JOURNAL = "telemetry.csv"  # a rig run's samples as they arrived (rigs/recorder.py)
 TUNING = "tuning.json"  # a rig tuning's result (articula rig tune)
+TUNED = "tuned.toml"  # a pneunet.pid config of the tuned gains (articula rig tune)
 IDENTIFICATION = "identification.json"  # a fit's constants (articula identify)
 IDENTIFICATION_FILES = frozenset({IDENTIFICATION, "plant.toml", "fit.png"})
 EXCITATION = re.compile(r"^excitation_\d+$")  # a rig identification's recordings, run folders
 SERVO = "servo.parquet"  # a plan's servo stream (articula plan --servo-rate)
 TABLES = frozenset({SERVO})  # the further tables a run may write beside trace.parquet
-RUN_FILES = frozenset({CONFIG, RECORD, TRACE, JOURNAL, TUNING}) | TABLES
+RUN_FILES = frozenset({CONFIG, RECORD, TRACE, JOURNAL, TUNING, TUNED}) | TABLES
 RUN_FOLDER = re.compile(r"^[0-9a-f]{12}$")  # a sweep's run folder: the config's hash
 # What atomic_write leaves when killed mid-write: .<name>.<8 random characters>.tmp
 TEMPORARY = re.compile(r"^\.(?P<name>.+)\.[A-Za-z0-9_]{8}\.tmp$")

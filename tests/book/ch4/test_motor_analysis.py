@@ -267,3 +267,16 @@ def test_analyze_reports_an_infeasible_current_as_none_with_a_reason():
     assert res["omega_c"] is None
     assert res["omega_c_note"]
     assert res["steady_state"]["voltage"] == 12.0
+
+
+def test_params_read_the_motor_table_identify_writes(tmp_path):
+    import tomli_w
+
+    plant = {"experiment": "motor.current", "rig": "single", "motor": TABLE_4_2.model_dump(),
+             "reference": {"current": 0.5, "speed": 0.0}}  # fmt: skip
+    (tmp_path / "plant.toml").write_text(tomli_w.dumps(plant))
+    assert motor_analysis.load_params(None, tmp_path / "plant.toml") == TABLE_4_2
+    del plant["motor"]["R"]
+    (tmp_path / "plant.toml").write_text(tomli_w.dumps(plant))
+    with pytest.raises(ConfigError, match=r"motor\.R"):
+        motor_analysis.load_params(None, tmp_path / "plant.toml")

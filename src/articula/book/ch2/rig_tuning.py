@@ -6,6 +6,10 @@ With `--model PLANT.toml` (a fitted PneuNet, `articula identify`'s plant.toml) t
 on the model in simulation, then is confirmed on the rig: a descent on the rig from the model's
 gains, with steps of a tenth of them, for CONFIRM_SWEEPS sweep(s), every experiment on the rig
 counted (tune_on_model).
+
+Beside tuning.json it writes tuned.toml, a pneunet.pid config of the tuned gains on the
+tuning's steps (with the fitted plant as its [plant] when tuned on a model), which `articula
+rig run PORT tuned.toml` runs on the rig and `articula run tuned.toml` in simulation.
 """
 
 from __future__ import annotations
@@ -17,18 +21,20 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import tomli_w
 
 from articula.book.ch2.study import ZN_LADDER, ZN_SEED_OFFSET
 from articula.book.ch2.tuning import TuningConfig, auto_run, auto_seed, manual_seed
 from articula.book.study import packaged
 from articula.errors import ConfigError
+from articula.experiments.pneunet import PneuNetPidConfig
 from articula.experiments.pneunet_on_rig import plant_config
 from articula.plants.pneunet import PneuNetParams
 from articula.rigs.link import Link
 from articula.rigs.pneunet import PneuNetRig
 from articula.rigs.programs import steps
 from articula.rigs.protocol import RigKind
-from articula.runs.folders import TUNING, check_out, claimed
+from articula.runs.folders import TUNED, TUNING, check_out, claimed
 from articula.runs.records import atomic_write
 from articula.tuning.coordinate_descent import coordinate_descent
 from articula.tuning.manual import (
@@ -100,6 +106,7 @@ def tune_on_rig(
         return {
             "method": method,
             "levels_deg": list(levels),
+            "hold_s": tuning.auto.hold,
             "gains": run.k.tolist(),
             "cost": run.cost,
             "experiments": run.evaluations,
@@ -111,6 +118,7 @@ def tune_on_rig(
         return {
             "method": method,
             "levels_deg": [level],
+            "hold_s": m.hold,
             "gains": found.gains.tolist(),
             "experiments": len(found.trials),
             "within_tolerance": found.within_tolerance,
@@ -123,6 +131,7 @@ def tune_on_rig(
     return {
         "method": method,
         "levels_deg": [level],
+        "hold_s": m.hold,
         "ku": ku,
         "tu_s": tu,
         "gains": ziegler_nichols(ku, tu, "PID").tolist(),
@@ -168,6 +177,7 @@ def tune_on_model(
         "method": "descent",
         "model": True,
         "levels_deg": list(levels),
+        "hold_s": a.hold,
         "gains": confirmed.k.tolist(),
         "cost": confirmed.cost,
         "experiments": confirmed.evaluations,
@@ -235,5 +245,37 @@ def tune_into(
         else:
             result = tune_on_model(tuning, plant, link, levels, index, on_experiment)
         result["link"] = dataclasses.asdict(link.stats)
+        result["tuned"] = TUNED
+        atomic_write(out_dir / TUNED, tuned_config(result, plant).encode())
         atomic_write(out_dir / TUNING, json.dumps(result, indent=2).encode())
     return result
+
+
+def tuned_config(result: dict[str, Any], plant: PneuNetParams | None) -> str:
+    """The tuned gains as a pneunet.pid config, on the tuning's own steps: what `rig run` and
+    `run` take without an edit.
+
+    Args:
+        result: a tuning's result (its method, levels_deg, hold_s and gains).
+        plant: the fitted PneuNet it was tuned on, as the config's [plant]; None: none
+            written (`run` then simulates the chapter's PneuNet).
+
+    Returns:
+        The config as TOML text, checked as `articula run` reads it.
+    """
+    levels = [float(v) for v in result["levels_deg"]]
+    data: dict[str, Any] = {
+        "experiment": "pneunet.pid",
+        "seed": 0,
+        "trials": 1,
+        "duration": len(levels) * float(result["hold_s"]),
+        "reference": {"kind": "steps", "levels_deg": levels},
+        "controller": {"name": f"{result['method']}-tuned", "schedule": "constant",
+                       "gains": [[float(k) for k in result["gains"]]]},
+    }  # fmt: skip
+    if plant is not None:
+        data["plant"] = plant.model_dump()
+    parse_model(PneuNetPidConfig, {k: v for k, v in data.items() if k != "experiment"}, TUNED)
+    head = f"# {result['method']} tuning's gains on the rig (articula rig tune)"
+    where = "the fitted plant it was tuned on" if plant else "none: the chapter's PneuNet"
+    return f"{head}; [plant]: {where}.\n" + tomli_w.dumps(data)

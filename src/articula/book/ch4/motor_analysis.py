@@ -15,17 +15,22 @@ from articula.plants.dc_motor import (
     steady_state,
     transfer_matrix,
 )
-from articula.validation import load_toml, parse_model
+from articula.validation import fields_renamed, load_toml, parse_model
 
 MAX_OPERATING = 1e6  # [V, N·m, A]: far beyond any motor, far below an overflow
 
 
 def load_params(preset: str | None, params_file: Path | None) -> MotorParams:
-    """Motor constants from a preset name or a TOML file with keys R, K, b, J, L."""
+    """Motor constants from a preset name or a TOML file with keys R, K, b, J, L, at its top
+    or in a [motor] table (a motor.current config: `identify motor`'s plant.toml)."""
     if (preset is None) == (params_file is None):
         raise ConfigError("--preset/--params", "give exactly one of --preset or --params")
     if params_file is not None:
-        return parse_model(MotorParams, load_toml(params_file), where=str(params_file))
+        data = load_toml(params_file)
+        if isinstance(data.get("motor"), dict):
+            with fields_renamed(lambda field: f"{params_file}: motor.{field}"):
+                return parse_model(MotorParams, data["motor"])
+        return parse_model(MotorParams, data, where=str(params_file))
     if preset not in PRESETS:
         raise ConfigError("--preset", f"unknown preset {preset!r}; choose {', '.join(PRESETS)}")
     return PRESETS[preset]
