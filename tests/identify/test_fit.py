@@ -5,8 +5,10 @@ no effect, which it must name as undetermined rather than guess."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from articula.identify.fit import fit_constants, nrmse
+from articula.plants.pneunet import PneuNetParams
 
 T = np.linspace(0.0, 2.0, 400)
 TRUE = {"a": 2.0, "tau": 0.3}
@@ -45,3 +47,38 @@ def test_nrmse_is_zero_for_the_signal_and_one_for_its_mean():
     y = np.sin(T * 7)
     assert nrmse(y, y) == 0.0
     assert abs(nrmse(y, np.full_like(y, y.mean())) - 1.0) < 1e-12
+
+
+@pytest.mark.parametrize("omega", [80.0, pytest.param(150.0, marks=pytest.mark.slow)])
+def test_a_pneunet_bending_faster_than_the_sampling_resolves_is_declared_unidentifiable(omega):
+    # Four step parts of the excitation's counts, 5 s each at the rig's 30 Hz, with the flex
+    # sensor's noise: the mode at 80-150 rad/s has under 4 samples a cycle.
+    from articula.identify.pneunet import PneuNetRecording, identify_pneunet, simulate
+
+    rng, dt = np.random.default_rng(3), 1 / 30
+    hidden = {"natural_frequency": omega, "damping_ratio": 0.15}
+    recordings = []
+    for count in (220, 120, 180, 60):
+        pwm = np.r_[np.full(150, count), np.zeros(150)]
+        angle = simulate(hidden, PneuNetRecording(dt, pwm, np.zeros(pwm.size)))
+        recordings.append(PneuNetRecording(dt, pwm, angle + rng.normal(0, 0.35, pwm.size)))
+    found = identify_pneunet(recordings)
+    assert {"natural_frequency", "damping_ratio"} <= set(found.fit.unidentifiable)
+    assert "natural_frequency" not in found.fit.values
+    assert found.bounds["natural_frequency"].startswith("≥ 47.1 rad/s")
+    assert found.fit.values["chamber_tau"] == pytest.approx(PneuNetParams().chamber_tau, rel=0.1)
+
+
+def test_the_book_pneunet_bending_keeps_its_mode_identified():
+    from articula.identify.pneunet import PneuNetRecording, identify_pneunet, simulate
+
+    rng, dt = np.random.default_rng(3), 1 / 30
+    recordings = []
+    for count in (220, 120, 180, 60):
+        pwm = np.r_[np.full(150, count), np.zeros(150)]
+        angle = simulate({}, PneuNetRecording(dt, pwm, np.zeros(pwm.size)))
+        recordings.append(PneuNetRecording(dt, pwm, angle + rng.normal(0, 0.35, pwm.size)))
+    found = identify_pneunet(recordings)
+    assert not found.bounds
+    omega = PneuNetParams().natural_frequency
+    assert found.fit.values["natural_frequency"] == pytest.approx(omega, rel=0.05)

@@ -80,6 +80,7 @@ def _show(summary: dict[str, Any], out_dir: Path, as_json: bool) -> None:
         error = summary["standard_errors"][name]
         out.print(f"{name} = {value:.5g} ± {error:.2g}")
     for name in summary["unidentifiable"]:
-        out.print(f"{name}: not determined by the data")
+        bound = summary["bounds"].get(name)
+        out.print(f"{name}: not determined by the data" + (f" ({bound})" if bound else ""))
     fits = ", ".join(f"{c} {v:.3f}" for c, v in summary["validation_nrmse"].items())
     out.print(f"validation NRMSE: {fits}; plant config {out_dir / 'plant.toml'}")

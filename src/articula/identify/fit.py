@@ -5,7 +5,7 @@ and the constants the data do not determine named as such."""
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -139,6 +139,8 @@ class Identification:
         start: every constant the model takes, as the fit started (SI).
         plant: the fitted plant as a config's tables (undetermined constants at their start).
         curves: the first recording's channels, measured against the model.
+        bounds: constant -> what the recordings bound it by, for one the sampling cannot
+            resolve (listed as unidentifiable too), e.g. "≥ 47.1 rad/s: ...".
     """
 
     fit: Fit
@@ -146,6 +148,7 @@ class Identification:
     start: dict[str, float]
     plant: dict[str, Any]
     curves: tuple[Curve, ...]
+    bounds: dict[str, str] = field(default_factory=dict)
 
     @property
     def constants(self) -> dict[str, float]:

@@ -37,6 +37,7 @@ def summary(rig: str, identification: Identification, sources: Sequence[str]) ->
         "parameters": fit.values,
         "standard_errors": fit.standard_errors,
         "unidentifiable": list(fit.unidentifiable),
+        "bounds": identification.bounds,
         "validation_nrmse": identification.validation_nrmse,
         "start": identification.start,
         "validation_fraction": VALIDATION,
