@@ -1,6 +1,6 @@
 """Plan configs of real arms among obstacles, shared by the tests: a Franka Panda (pybullet_data)
 circling past a box, a ball and a mesh (the "Panda tight scene"), a Universal Robots UR10 and UR5
-and a Kinova Jaco 2 (example-robot-data) each circling past a ball."""
+and a Kinova Jaco 2 (example-robot-data) and the built-in UR5e each circling past a ball."""
 
 from __future__ import annotations
 
@@ -47,10 +47,15 @@ def ur10_robot() -> dict:
 
 
 def ur5_robot() -> dict:
-    """The UR5 (CB3) of example-robot-data (it has no UR5e), at the UR10's home."""
+    """The UR5 (CB3) of example-robot-data, at the UR10's home."""
     share = robot_data()
     urdf = share / "example-robot-data/robots/ur_description/urdf/ur5_robot.urdf"
     return {"urdf": str(urdf), "package_dirs": [str(share)], "q0": UR10_HOME}
+
+
+def ur5e_robot() -> dict:
+    """The UR5e shipped with articula (robots/data/ur5e), at the UR10's home."""
+    return {"builtin": "ur5e", "q0": UR10_HOME}
 
 
 def jaco2_robot(q0: list[float] | None = None) -> dict:
@@ -63,8 +68,8 @@ def jaco2_robot(q0: list[float] | None = None) -> dict:
 def arm_scene(name: str, duration: float = 12.0) -> dict:
     """A plan config of one arm circling past obstacles, with the [planner] defaults but for
     Λ, d_min and the run's length: "panda" (a box, a ball and a mesh; d_min 5 mm), "xarm6" (a
-    ball and a box), "ur10" (a ball; d_min 20 mm), "ur5" (a ball; d_min 15 mm) or "jaco2" (a
-    ball; d_min 10 mm)."""
+    ball and a box), "ur10" (a ball; d_min 20 mm), "ur5" or "ur5e" (a ball; d_min 15 mm) or "jaco2"
+    (a ball; d_min 10 mm)."""
     planner = {"lambda_weight": 0.002, "d_min": 0.005, "duration": duration, "settle": 2.0}
     if name == "panda":
         return {"robot": panda_robot(), "planner": planner,
@@ -84,6 +89,11 @@ def arm_scene(name: str, duration: float = 12.0) -> dict:
                 "trajectory": {**CIRCLE, "center": [0.49, 0.11, 0.37], "radius": 0.07},
                 "obstacles": [{"name": "ball", "sphere": 0.04,
                                "position": [0.46, 0.27, 0.44]}]}  # fmt: skip
+    if name == "ur5e":  # the UR5's scene moved with the tool at home (+5 mm x, +24 y, +56 z)
+        return {"robot": ur5e_robot(), "planner": {**planner, "d_min": 0.015},
+                "trajectory": {**CIRCLE, "center": [0.50, 0.13, 0.43], "radius": 0.07},
+                "obstacles": [{"name": "ball", "sphere": 0.04,
+                               "position": [0.47, 0.29, 0.50]}]}  # fmt: skip
     if name == "jaco2":
         return {"robot": jaco2_robot(), "planner": {**planner, "d_min": 0.01},
                 "trajectory": {**CIRCLE, "center": [0.18, -0.23, 0.40], "radius": 0.06},

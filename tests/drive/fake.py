@@ -73,8 +73,8 @@ def environment() -> dict[str, str]:
 def scene_file(
     folder: Path, duration: float = 4.0, robot: dict | None = None, name: str = "ur10"
 ) -> Path:
-    """A UR scene (tests.arms: "ur10" or "ur5") of `duration` [s] written to folder/NAME.toml,
-    its [robot] updated with `robot`."""
+    """A UR scene (tests.arms: "ur10", "ur5" or "ur5e") of `duration` [s] written to
+    folder/NAME.toml, its [robot] updated with `robot`."""
     data = arm_scene(name, duration)
     if robot is not None:
         data["robot"] |= robot

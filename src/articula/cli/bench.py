@@ -36,7 +36,7 @@ def suite(
     robot: Annotated[
         str,
         typer.Option(
-            help="iiwa14, a URDF file, or a TOML file with a [robot] table "
+            help="a built-in arm (iiwa14, ur5e), a URDF file, or a TOML file with a [robot] table "
             "(urdf, package_dirs, ee_frame, locked_joints, ...)."
         ),
     ] = "iiwa14",

@@ -26,7 +26,10 @@ from articula.robots._urdf_kinematics import (
 from articula.robots.limits import ACCEL_TIME, JERK_TIME, default_sources, rise_limit
 from articula.robots.urdf_geometry import collision_shapes
 
-BUILTIN = {"iiwa14": ("iiwa14/iiwa14.urdf", "iiwa_link_ee")}
+BUILTIN = {
+    "iiwa14": ("iiwa14/iiwa14.urdf", "iiwa_link_ee"),
+    "ur5e": ("ur5e/ur5e.urdf", "tool0"),
+}
 
 
 @dataclass(frozen=True, eq=False)
@@ -178,7 +181,7 @@ class RobotModel:
         """A robot shipped with articula.
 
         Args:
-            name: "iiwa14" (KUKA LBR iiwa 14 R820).
+            name: "iiwa14" (KUKA LBR iiwa 14 R820) or "ur5e" (Universal Robots UR5e).
             ee_frame: overrides its end-effector frame.
             locked_joints: joint name -> fixed value [rad or m] (see `from_urdf`).
             ee_offset: pose (4×4) of the tool point in the end-effector frame [m].

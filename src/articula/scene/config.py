@@ -61,7 +61,7 @@ class RobotSpec(StrictModel):
     lock at fixed values [rad or m] and the tool point's offset from ee_frame.
 
     Attributes:
-        builtin: name of a robot shipped with articula ("iiwa14"); give this or `urdf`.
+        builtin: name of a robot shipped with articula ("iiwa14", "ur5e"); give this or `urdf`.
         urdf: path of the URDF file (relative to the scene file, or package://articula/...).
         package_dirs: folders that hold the packages the URDF's package:// meshes name.
         ee_frame: the end-effector frame; default the built-in robot's, or the last link.
