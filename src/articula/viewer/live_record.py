@@ -84,7 +84,9 @@ class Recording:
         plant: Any,
         wall_time: float,
     ) -> dict[str, Any]:
-        """The recording as a run folder `articula view` replays.
+        """The recording as a run folder `articula view` replays. A signal that ends the
+        session lands anywhere in a period, between one column's row and the next: the period
+        it cut short is left out, so every column has the same periods.
 
         Args:
             folder: the run folder to write.
@@ -100,7 +102,7 @@ class Recording:
         Returns:
             The run's record (record.json).
         """
-        if not self.t:
+        if not self._keep_whole_periods(plant):
             raise ArticulaError("--record: nothing happened yet (no control period ran)")
         x, x_ref = np.array(self.x), np.array(self.x_ref)
         run = PlanResult(
@@ -127,3 +129,21 @@ class Recording:
         record = build_record(config, Result(metrics, {}), wall_time)
         write_run(folder, config, record, trace)
         return record
+
+    def _keep_whole_periods(self, plant: Any) -> int:
+        """Cut every per-period column (the plant's too) to the periods all of them reached.
+
+        Returns:
+            The number of periods kept.
+        """
+        columns = [self.t, self.q, self.x, self.x_ref, self.clearance, self.step_ms]
+        columns += self.obstacles.values()
+        if plant is not None:
+            columns.append(self.measured_clearance)
+        periods = min(map(len, columns))
+        if plant is not None:
+            periods = min(periods, plant.periods)
+            plant.truncate(periods)
+        for rows in columns:
+            del rows[periods:]
+        return periods
