@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import tomli_w
 import trimesh
 from scipy.spatial import ConvexHull
 
@@ -268,6 +269,32 @@ def test_scene_check_reports_joint_limits(cli):
     q = "0,0,0,0,0,0,3.1"
     outside = json.loads(cli("scene", "check", TWO_OBSTACLES, "--q", q, "--json").stdout)
     assert outside["within_limits"] is False  # joint 7 is limited to ±175° = ±3.054 rad
+    (joint,) = outside["outside_limits"]
+    assert (joint["joint"], joint["value"]) == ("iiwa_joint_7", 3.1)
+    assert (joint["lower"], joint["upper"]) == pytest.approx((-3.0543, 3.0543), abs=1e-4)
+    assert inside["outside_limits"] == []
+
+
+def test_scene_check_warns_of_a_q0_outside_the_joint_limits(capsys, tmp_path):
+    """Issue 48: only --json said within_limits: false; the table now comes with one warning
+    line naming the joint, its value and its limits (and none for a q0 within them)."""
+    config = load_toml(TWO_OBSTACLES)
+    for obstacle in config["obstacles"]:
+        obstacle["mesh"] = str(CONFIGS / obstacle["mesh"])
+    config["robot"]["q0"] = [0.0, 0.5, 0.0, -1.0, 0.0, 0.6, 3.1]
+    scene = tmp_path / "scene.toml"
+    scene.write_text(tomli_w.dumps(config))
+    main(["scene", "check", str(scene)])
+    captured = capsys.readouterr()
+    assert "iiwa_link_7" in captured.out  # the table as before
+    assert captured.err.splitlines() == [
+        "warning: robot.q0: iiwa_joint_7 = 3.1000 rad, outside [-3.0543, 3.0543]; plan and "
+        "live refuse to start outside the joint limits"
+    ]
+    main(["scene", "check", str(scene), "--q", "0,0,-2.97,0,0,0,0"])
+    assert capsys.readouterr().err.startswith("warning: --q: iiwa_joint_3 = -2.9700 rad,")
+    main(["scene", "check", str(TWO_OBSTACLES)])
+    assert capsys.readouterr().err == ""
 
 
 def test_many_configurations_from_a_csv_or_parquet_file_give_one_row_each(cli, one_json, tmp_path):

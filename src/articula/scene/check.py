@@ -87,7 +87,8 @@ def check_scene(
     Returns:
         The summary of the configuration: q [rad], ee_position [m], min_clearance [m],
         link_clearance and obstacle_clearance by name [m], self_clearance [m],
-        self_closest_pair, self_collides, self_collision_checked, collides, within_limits and
+        self_closest_pair, self_collides, self_collision_checked, collides, within_limits,
+        outside_limits (each joint outside its limits: joint, value, lower, upper [rad]) and
         metric; with `q_file`, {"configurations": [one summary per row]}.
     """
     spec = load_scene_spec(load_toml(path), str(path))
@@ -120,6 +121,8 @@ def _check(scene: Scene, itself: Scene, q: np.ndarray, metric: str) -> dict[str,
     d_self = itself.self_distances(q)
     closest = int(np.argmin(d_self)) if d_self.size else None
     self_clearance = float(d_self[closest]) if closest is not None else float("inf")
+    robot = scene.robot
+    outside = np.flatnonzero((q < robot.lower) | (q > robot.upper))
     return {
         "q": q.tolist(),
         "ee_position": scene.robot.ee_position(q).tolist(),
@@ -136,6 +139,15 @@ def _check(scene: Scene, itself: Scene, q: np.ndarray, metric: str) -> dict[str,
         "self_collides": bool(self_clearance < 0.0),
         "self_collision_checked": bool(scene.self_pairs),
         "collides": bool(min_clearance < 0.0 or (scene.self_pairs and self_clearance < 0.0)),
-        "within_limits": bool(np.all((q >= scene.robot.lower) & (q <= scene.robot.upper))),
+        "within_limits": not outside.size,
+        "outside_limits": [
+            {
+                "joint": robot.joint_names[j],
+                "value": float(q[j]),
+                "lower": float(robot.lower[j]),
+                "upper": float(robot.upper[j]),
+            }
+            for j in outside
+        ],
         "metric": metric,
     }
