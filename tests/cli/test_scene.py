@@ -332,3 +332,43 @@ def test_the_table_of_many_configurations_names_every_column(cli, tmp_path):
     assert proc.returncode == 0, proc.stderr
     for header in ("row", "min clearance [m]", "self clearance [m]"):
         assert header in proc.stdout, proc.stdout
+
+
+def test_a_runs_own_trace_is_a_q_file(cli, check_in_process, tmp_path):
+    """Issue 48: --q-file refused a run's trace.parquet (its t, phase, x, ... columns); its
+    q_1..q_7 are taken, one configuration per period, and the clearances are the run's."""
+    import pyarrow.parquet as pq
+
+    config = load_toml(CONFIGS / "circle_two_obstacles.toml")
+    for obstacle in config["obstacles"]:
+        obstacle["mesh"] = str(CONFIGS / obstacle["mesh"])
+    config["planner"] |= {"method": "qp", "duration": 0.3, "settle": 0.1}
+    scene = tmp_path / "scene.toml"
+    scene.write_text(tomli_w.dumps(config))
+    proc = cli("plan", scene, "--out", tmp_path / "run")
+    assert proc.returncode == 0, proc.stderr
+    trace = pq.read_table(tmp_path / "run" / "trace.parquet").to_pydict()
+    q = np.column_stack([trace[f"q_{j + 1}"] for j in range(7)])
+    for kind in ("parquet", "csv"):
+        path = tmp_path / "run" / "trace.parquet"
+        if kind == "csv":  # the same table as CSV, its columns named
+            path = tmp_path / "trace.csv"
+            names = [n for n in trace if n != "phase"][::-1]  # in any order
+            rows = zip(*(trace[n] for n in names), strict=True)
+            path.write_text(
+                ",".join(names) + "\n" + "\n".join(",".join(map(repr, r)) for r in rows)
+            )
+        configurations = check_in_process(scene, "--q-file", path)["configurations"]
+        np.testing.assert_array_equal([c["q"] for c in configurations], q)
+        clearance = [c["min_clearance"] for c in configurations]
+        np.testing.assert_allclose(clearance, trace["clearance"], atol=1e-6)
+
+
+def test_a_q_file_with_another_robots_joints_is_one_line(main_fails, tmp_path):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    path = tmp_path / "trace.parquet"
+    pq.write_table(pa.table({"t": [0.0], **{f"q_{j + 1}": [0.0] for j in range(6)}}), path)
+    line = main_fails("scene", "check", TWO_OBSTACLES, "--q-file", path)
+    assert "--q-file" in line and "q_1 to q_7" in line and "not a table" not in line

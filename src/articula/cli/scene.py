@@ -23,7 +23,11 @@ def scene_check(
     ] = "gjk",
     q_file: Annotated[
         Path | None,
-        typer.Option("--q-file", help="CSV or Parquet: one configuration per row [rad]."),
+        typer.Option(
+            "--q-file",
+            help="CSV or Parquet: one configuration per row [rad]; a run's trace.parquet: its "
+            "q_1..q_n columns, one row per control period.",
+        ),
     ] = None,
     as_json: JsonFlag = False,
 ) -> None:
