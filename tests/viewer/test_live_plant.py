@@ -16,7 +16,7 @@ import pytest
 import tomli_w
 import viser
 
-from articula.signals import Terminated, terminate_as_interrupt
+from articula.signals import Interrupted, Terminated, terminate_as_interrupt
 from articula.viewer.drawing import wxyz_position
 from articula.viewer.live import Live, LiveScene
 from articula.viewer.run_data import load_run
@@ -150,7 +150,7 @@ def test_a_session_stopped_by_a_signal_anywhere_in_a_period_is_written_whole(
             live.period()
         signum = [signal.SIGINT, signal.SIGTERM][trial % 2]
         trace = signal_at(int(rng.integers(1, counter.seen())), signum)
-        with pytest.raises((KeyboardInterrupt, Terminated)), terminate_as_interrupt():
+        with pytest.raises((Interrupted, Terminated)), terminate_as_interrupt():
             sys.settrace(trace)  # here: only the periods' events count
             try:
                 live.period()
