@@ -60,3 +60,29 @@ def test_the_your_arm_page_runs_and_prints_what_it_says(capsys, tmp_path, monkey
     exec(compile(code, "your-arm.md", "exec"), {})
     assert capsys.readouterr().out == shown
     assert (tmp_path / "rock.stl").is_file()
+
+
+def test_the_arm_tracking_pages_code_prints_what_its_comment_says(capsys):
+    """Issue 48: the comment had gone stale (40.1 mm where the code printed another number)."""
+    page = (DOCS / "guides" / "arm-tracking.md").read_text(encoding="utf-8")
+    section = page[page.index("## From Python") :]
+    code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    shown = re.search(r"^# (rms .*)$", code, re.M).group(1)
+    exec(compile(code, "arm-tracking.md", "exec"), {})
+    printed = capsys.readouterr().out.strip()
+    # the errors and clearance are the run's own; the time per period is the machine's
+    assert printed.rsplit(", ", 1)[0] == shown.rsplit(", ", 1)[0], printed
+
+
+def test_the_arm_tracking_pages_scene_check_shows_what_it_prints(capsys):
+    """Every line the page shows of `articula scene check` is printed (rich wraps long lines
+    to the width of a pipe: compared word by word)."""
+    from articula.cli import main
+
+    page = (DOCS / "guides" / "arm-tracking.md").read_text(encoding="utf-8")
+    block = re.search(r"```text\n\$ articula scene check (.*?)\n(.*?)```", page, re.S)
+    scene, q = re.fullmatch(r'(\S+) --q "(.*)"', block.group(1)).groups()
+    main(["scene", "check", str(ROOT / scene), "--q", q])
+    printed = " ".join(capsys.readouterr().out.split())
+    for line in block.group(2).splitlines():
+        assert " ".join(line.split()) in printed, line

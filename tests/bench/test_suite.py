@@ -5,10 +5,14 @@ from __future__ import annotations
 
 import importlib.util
 
+import numpy as np
 import pyarrow.parquet as pq
 import pytest
+import tomli_w
 
 from articula.bench import suite
+from articula.validation import load_toml
+from tests.arms import jaco2_robot
 
 PEERS = importlib.util.find_spec("mink") is not None and importlib.util.find_spec("mujoco")
 
@@ -114,3 +118,20 @@ def test_the_tight_suite_on_dask_gives_the_local_numbers(tmp_path):
         rows = pq.read_table(out / "results.parquet").to_pylist()
         runs[backend] = [{k: v for k, v in r.items() if not k.endswith("_us")} for r in rows]
     assert runs[None] == runs["local"] and len(runs[None]) == 2
+
+
+def test_an_arm_with_continuous_joints_gets_starts_within_a_turn(tmp_path, cli, one_json):
+    """Issue 48: the Jaco 2's continuous joints 1, 4 and 6 have ±inf limits, and starts drawn
+    between them failed the suite ("Range exceeds valid bounds"); they are drawn over
+    (−π, π]."""
+    robot = {k: v for k, v in jaco2_robot().items() if k != "q0"}
+    (tmp_path / "kinova.toml").write_text(tomli_w.dumps({"robot": robot}))
+    out = tmp_path / "suite"
+    proc = cli("bench", "suite", "--robot", tmp_path / "kinova.toml", "--problems", "2",
+               "--methods", "qp", "--workers", "1", "--out", out, "--json")  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    summary = one_json(proc.stdout)
+    assert summary["problems"] == 2 and summary["methods"]["qp"]["failures"]["error"] == 0
+    for k in range(2):
+        q0 = np.array(load_toml(out / "problems" / f"{k:03d}" / "scene.toml")["robot"]["q0"])
+        assert np.all((-np.pi < q0[[0, 3, 5]]) & (q0[[0, 3, 5]] <= np.pi))

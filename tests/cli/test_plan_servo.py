@@ -64,7 +64,9 @@ def test_the_line_gives_the_streams_acceleration_and_jerk_ratios(cli, tmp_path):
     line = " ".join(proc.stdout.split())
     assert (
         f"servo at {m['servo_max_acceleration_ratio']:.2f} of the acceleration and "
-        f"{m['servo_max_jerk_ratio']:.2f} of the jerk limits" in line
+        f"{m['servo_max_jerk_ratio']:.2f} of the jerk limits, "
+        f"{m['servo_max_velocity_ratio']:.2f} of the speed limits, "
+        f"{int(m['servo_clipped'])} set-points clipped" in line  # issue 48: all of the stream's
     )
     assert "twin:" not in line
 

@@ -59,11 +59,13 @@ def test_a_stiff_twin_steps_aside_with_the_plan_and_the_line_says_how_it_tracked
     assert f"max {1e3 * m['max_error']:.3f} mm" in line
     assert (
         f"servo at {m['servo_max_acceleration_ratio']:.2f} of the acceleration and "
-        f"{m['servo_max_jerk_ratio']:.2f} of the jerk limits" in line
+        f"{m['servo_max_jerk_ratio']:.2f} of the jerk limits, "
+        f"{m['servo_max_velocity_ratio']:.2f} of the speed limits, "
+        f"{int(m['servo_clipped'])} set-points clipped" in line  # issue 48: all of the stream's
     )
     assert (
         f"twin: RMS error {1e3 * m['plant_rms_error']:.3f} mm, torque at "
-        f"{m['max_torque_ratio']:.2f} of the effort limits" in line
+        f"{m['max_torque_ratio']:.2f} of the effort limits, contacts in 0 periods" in line
     )
 
 

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import tomli_w
 import trimesh
 from scipy.spatial import ConvexHull
 
@@ -268,6 +269,32 @@ def test_scene_check_reports_joint_limits(cli):
     q = "0,0,0,0,0,0,3.1"
     outside = json.loads(cli("scene", "check", TWO_OBSTACLES, "--q", q, "--json").stdout)
     assert outside["within_limits"] is False  # joint 7 is limited to ±175° = ±3.054 rad
+    (joint,) = outside["outside_limits"]
+    assert (joint["joint"], joint["value"]) == ("iiwa_joint_7", 3.1)
+    assert (joint["lower"], joint["upper"]) == pytest.approx((-3.0543, 3.0543), abs=1e-4)
+    assert inside["outside_limits"] == []
+
+
+def test_scene_check_warns_of_a_q0_outside_the_joint_limits(capsys, tmp_path):
+    """Issue 48: only --json said within_limits: false; the table now comes with one warning
+    line naming the joint, its value and its limits (and none for a q0 within them)."""
+    config = load_toml(TWO_OBSTACLES)
+    for obstacle in config["obstacles"]:
+        obstacle["mesh"] = str(CONFIGS / obstacle["mesh"])
+    config["robot"]["q0"] = [0.0, 0.5, 0.0, -1.0, 0.0, 0.6, 3.1]
+    scene = tmp_path / "scene.toml"
+    scene.write_text(tomli_w.dumps(config))
+    main(["scene", "check", str(scene)])
+    captured = capsys.readouterr()
+    assert "iiwa_link_7" in captured.out  # the table as before
+    assert captured.err.splitlines() == [
+        "warning: robot.q0: iiwa_joint_7 = 3.1000 rad, outside [-3.0543, 3.0543]; plan and "
+        "live refuse to start outside the joint limits"
+    ]
+    main(["scene", "check", str(scene), "--q", "0,0,-2.97,0,0,0,0"])
+    assert capsys.readouterr().err.startswith("warning: --q: iiwa_joint_3 = -2.9700 rad,")
+    main(["scene", "check", str(TWO_OBSTACLES)])
+    assert capsys.readouterr().err == ""
 
 
 def test_many_configurations_from_a_csv_or_parquet_file_give_one_row_each(cli, one_json, tmp_path):
@@ -305,3 +332,43 @@ def test_the_table_of_many_configurations_names_every_column(cli, tmp_path):
     assert proc.returncode == 0, proc.stderr
     for header in ("row", "min clearance [m]", "self clearance [m]"):
         assert header in proc.stdout, proc.stdout
+
+
+def test_a_runs_own_trace_is_a_q_file(cli, check_in_process, tmp_path):
+    """Issue 48: --q-file refused a run's trace.parquet (its t, phase, x, ... columns); its
+    q_1..q_7 are taken, one configuration per period, and the clearances are the run's."""
+    import pyarrow.parquet as pq
+
+    config = load_toml(CONFIGS / "circle_two_obstacles.toml")
+    for obstacle in config["obstacles"]:
+        obstacle["mesh"] = str(CONFIGS / obstacle["mesh"])
+    config["planner"] |= {"method": "qp", "duration": 0.3, "settle": 0.1}
+    scene = tmp_path / "scene.toml"
+    scene.write_text(tomli_w.dumps(config))
+    proc = cli("plan", scene, "--out", tmp_path / "run")
+    assert proc.returncode == 0, proc.stderr
+    trace = pq.read_table(tmp_path / "run" / "trace.parquet").to_pydict()
+    q = np.column_stack([trace[f"q_{j + 1}"] for j in range(7)])
+    for kind in ("parquet", "csv"):
+        path = tmp_path / "run" / "trace.parquet"
+        if kind == "csv":  # the same table as CSV, its columns named
+            path = tmp_path / "trace.csv"
+            names = [n for n in trace if n != "phase"][::-1]  # in any order
+            rows = zip(*(trace[n] for n in names), strict=True)
+            path.write_text(
+                ",".join(names) + "\n" + "\n".join(",".join(map(repr, r)) for r in rows)
+            )
+        configurations = check_in_process(scene, "--q-file", path)["configurations"]
+        np.testing.assert_array_equal([c["q"] for c in configurations], q)
+        clearance = [c["min_clearance"] for c in configurations]
+        np.testing.assert_allclose(clearance, trace["clearance"], atol=1e-6)
+
+
+def test_a_q_file_with_another_robots_joints_is_one_line(main_fails, tmp_path):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    path = tmp_path / "trace.parquet"
+    pq.write_table(pa.table({"t": [0.0], **{f"q_{j + 1}": [0.0] for j in range(6)}}), path)
+    line = main_fails("scene", "check", TWO_OBSTACLES, "--q-file", path)
+    assert "--q-file" in line and "q_1 to q_7" in line and "not a table" not in line

@@ -9,6 +9,7 @@ import signal
 import urllib.request
 
 import numpy as np
+import pyarrow.parquet as pq
 import pytest
 import tomli_w
 import viser
@@ -162,3 +163,29 @@ def test_the_panel_switches_a_baornn_scene_with_an_acceleration_limit_to_qp(serv
     assert "not changed" not in live.readout.content, live.readout.content
     assert live.spec().method == "qp"
     live.close()
+
+
+@pytest.mark.parametrize("self_collision", [True, False])
+def test_a_live_record_has_the_self_clearance_of_the_checked_pairs(
+    server, scene_file, tmp_path, self_collision
+):
+    """Issue 48: live records said min_self_clearance: None. With self-collision on it is the
+    smallest distance of the checked link pairs over the session (the scene's own, at each
+    recorded q) and the trace has a self_clearance column; off, None as in plan's record."""
+    config = load_toml(scene_file)
+    config["robot"]["self_collision"] = self_collision
+    scene_file.write_text(tomli_w.dumps(config))
+    live = Live(server, LiveScene.load(scene_file, "qp"))
+    for _ in range(20):
+        live.period()
+    live.close()
+    record = live.write(tmp_path / "rec", 1.0)
+    trace = pq.read_schema(tmp_path / "rec" / "trace.parquet").names
+    scene = live.scene
+    if not self_collision:
+        assert not scene.self_pairs and record["metrics"]["min_self_clearance"] is None
+        assert "self_clearance" not in trace
+        return
+    oracle = min(float(scene.self_distances(q).min()) for q in live.recording.q)
+    assert record["metrics"]["min_self_clearance"] == pytest.approx(oracle, abs=1e-6)
+    assert record["metrics"]["self_collisions"] == 0 and "self_clearance" in trace

@@ -15,6 +15,7 @@ import pytest
 import viser
 
 from articula.viewer.replay import ERROR_FLOOR_MM, TRAIL_POSES, Replay
+from articula.viewer.run_data import load_run
 from articula.viewer.time_plot import CURSOR_COLOUR, thinned
 from tests.viewer.conftest import free_port, keep_screenshot, open_page, robot_mask, screenshot
 
@@ -72,6 +73,21 @@ def test_a_run_renders_and_the_slider_moves_the_arm(planned_run, viewer, browser
             break
     assert trail > pale + 3000, (pale, trail)
     keep_screenshot(page, "view_trail.png", tmp_path)
+
+
+def test_a_time_typed_beyond_the_run_is_put_back_in_the_box(planned_run, viewer, browser):
+    """Issue 48: the box kept a time typed beyond the run (999) while the arm showed its end."""
+    sync_api = pytest.importorskip("playwright.sync_api")
+    _, url = viewer("view", planned_run)
+    page = open_page(browser, url)
+    end = float(load_run(planned_run).t[-1])
+    time_box = page.locator("input[inputmode='decimal']:visible").first  # the slider's box
+    for typed, shown in (("999", end), ("-5", 0.0)):
+        time_box.fill(typed)
+        time_box.press("Enter")  # still focused: the box shows what the server sends back
+        sync_api.expect(time_box).not_to_have_value(typed, timeout=30_000)
+        assert float(time_box.input_value()) == pytest.approx(shown, abs=1e-6)
+        page.get_by_text(f"t = {shown:.2f} s").wait_for(timeout=30_000)
 
 
 def test_two_tabs_and_a_closed_browser_leave_the_server_serving(planned_run, viewer, browser):

@@ -2,8 +2,9 @@
 
 Problem i of seed S draws everything from numpy.random.default_rng([S, i]):
 
-1. a start q0 uniform within the joint limits (shrunk by a tenth of each range), clear of the
-   arm itself by START_SELF_CLEARANCE on the pairs of its allowed-collision matrix;
+1. a start q0 uniform within the joint limits (shrunk by a tenth of each range; a continuous
+   joint over (−π, π]), clear of the arm itself by START_SELF_CLEARANCE on the pairs of its
+   allowed-collision matrix;
 2. a path from the start's end-effector position: a circle (radius 5-15 cm, any plane, the
    start on it) or a line segment (10-25 cm, any direction, out and back), over 4-6 s;
    kept only if damped least squares without obstacles tracks it within REACH_RMS (so the
@@ -169,10 +170,13 @@ def _robot(table_json: str) -> tuple[RobotModel, Scene]:
 
 
 def _start(robot: RobotModel, checked: Scene, rng: np.random.Generator) -> np.ndarray:
-    """A start within the shrunk limits, START_SELF_CLEARANCE clear of the arm itself."""
-    margin = 0.1 * (robot.upper - robot.lower)
+    """A start within the shrunk limits (a continuous joint anywhere in (−π, π]: its limits
+    are ±inf), START_SELF_CLEARANCE clear of the arm itself."""
+    lower, upper = robot.sample_range
+    margin = np.where(robot.continuous, 0.0, 0.1 * (upper - lower))
     for _ in range(ATTEMPTS):
-        q0 = rng.uniform(robot.lower + margin, robot.upper - margin)
+        # uniform draws [−π, π) on a continuous joint; wrap sends −π to π
+        q0 = robot.wrap(rng.uniform(lower + margin, upper - margin))
         if not checked.self_pairs or checked.clearances(q0)[1] > START_SELF_CLEARANCE:
             return q0
     raise InfeasibleError(f"no self-collision-free start in {ATTEMPTS} draws", "robot")

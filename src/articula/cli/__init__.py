@@ -34,7 +34,7 @@ from articula.cli import (  # noqa: F401  (each module adds its commands to app)
 from articula.cli.app import app
 from articula.cli.words import speak_in_words
 from articula.errors import ArticulaError, CollisionError, DeviceError, ResourceError
-from articula.signals import Terminated
+from articula.signals import Interrupted, Terminated
 
 BAD_INPUT, ENVIRONMENT, BUG, COLLIDES, INTERRUPTED, TERMINATED = 2, 1, 3, 4, 130, 143
 # OS errors that the machine causes; every other OSError is about a path the user gave.
@@ -64,8 +64,10 @@ def main(argv: list[str] | None = None) -> None:
             if debug:
                 raise
             _fail(*_status_and_message(exc))
-        except Terminated:
-            _fail(TERMINATED, "terminated (SIGTERM); finished work is kept, as on Ctrl-C")
+        except Terminated:  # a server, a live loop, an emulated rig or a drive
+            _fail(TERMINATED, "terminated (SIGTERM)")
+        except Interrupted:  # the same, on Ctrl-C
+            _fail(INTERRUPTED, "interrupted (Ctrl-C)")
         except KeyboardInterrupt:
             _fail(
                 INTERRUPTED,

@@ -98,8 +98,9 @@ def plan(
 
 
 def _summary(m: dict) -> str:
-    """The run's line: errors, clearance, stall, the stream's and the twin's key ratios (those
-    the record has), the planner's time per iteration."""
+    """The run's line: errors, clearance, stall, the stream's ratios and clipped set-points
+    and the twin's error, torque ratio and contacts (those the record has), the planner's time
+    per iteration."""
     settled = f"after {m['settle_s']:g} s"
     if m.get("approach_s"):
         settled = f"{m['settle_s']:g} s into the path (after a {m['approach_s']:.2g} s approach)"
@@ -115,11 +116,14 @@ def _summary(m: dict) -> str:
     if "servo_max_jerk_ratio" in m:
         parts.append(
             f"servo at {m['servo_max_acceleration_ratio']:.2f} of the acceleration and "
-            f"{m['servo_max_jerk_ratio']:.2f} of the jerk limits"
+            f"{m['servo_max_jerk_ratio']:.2f} of the jerk limits, "
+            f"{m['servo_max_velocity_ratio']:.2f} of the speed limits, "
+            f"{int(m['servo_clipped'])} set-points clipped"
         )
     if "plant_rms_error" in m:
         parts.append(
             f"twin: RMS error {1e3 * m['plant_rms_error']:.3f} mm, torque at "
-            f"{m['max_torque_ratio']:.2f} of the effort limits"
+            f"{m['max_torque_ratio']:.2f} of the effort limits, contacts in "
+            f"{int(m['plant_contacts'])} periods"
         )
     return "; ".join([*parts, f"{m['time_per_iteration_us']:.1f} µs per iteration"])

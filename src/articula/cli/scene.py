@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from articula.cli.app import JsonFlag, emit_json, out, print_table, scene_app
+from articula.cli.app import JsonFlag, emit_json, err, out, print_table, scene_app
 
 
 @scene_app.command("check")
@@ -23,7 +23,11 @@ def scene_check(
     ] = "gjk",
     q_file: Annotated[
         Path | None,
-        typer.Option("--q-file", help="CSV or Parquet: one configuration per row [rad]."),
+        typer.Option(
+            "--q-file",
+            help="CSV or Parquet: one configuration per row [rad]; a run's trace.parquet: its "
+            "q_1..q_n columns, one row per control period.",
+        ),
     ] = None,
     as_json: JsonFlag = False,
 ) -> None:
@@ -51,6 +55,8 @@ def scene_check(
         header = ("row", "min clearance [m]", "self clearance [m]")
         print_table(f"{scene_file} ({metric} metric)", header, rows)
         return
+    if result["outside_limits"]:
+        _warn_outside_limits("robot.q0" if q is None else "--q", result["outside_limits"])
     rows = [(name, f"{value:.4f}") for name, value in result["link_clearance"].items()]
     print_table(f"{scene_file} ({metric} metric)", ("link", "clearance [m]"), rows)
     x, y, z = result["ee_position"]
@@ -63,4 +69,19 @@ def scene_check(
     out.print(
         f"self clearance {result['self_clearance']:.4f} m ({pair}); self collides: "
         f"{result['self_collides']}{checked}"
+    )
+
+
+def _warn_outside_limits(field: str, outside: list[dict]) -> None:
+    """One line on stderr naming each joint outside its limits, its value and the limits."""
+    joints = ", ".join(
+        f"{o['joint']} = {o['value']:.4f} rad, outside [{o['lower']:.4f}, {o['upper']:.4f}]"
+        for o in outside
+    )
+    # only --json leaves it out: a warning there would not be one JSON object
+    err.print(
+        f"warning: {field}: {joints}; plan and live refuse to start outside the joint limits",
+        soft_wrap=True,
+        markup=False,
+        highlight=False,
     )

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any
 
@@ -32,7 +33,9 @@ def parse_q(text: str) -> np.ndarray:
 
 def read_q_file(path: Path, nq: int, max_rows: int = MAX_ROWS) -> np.ndarray:
     """Configurations [rad], one per row, from a CSV (a header line is allowed) or Parquet file
-    of `nq` numeric columns.
+    of `nq` numeric columns, or from the columns q_1..q_nq of a file that names them (a run's
+    trace.parquet: each row one control period's commanded joints, in the order of its t; its
+    other columns, the twin's measured qm_* among them, are left out).
 
     Args:
         path: the .csv or .parquet file (--q-file).
@@ -49,12 +52,21 @@ def read_q_file(path: Path, nq: int, max_rows: int = MAX_ROWS) -> np.ndarray:
             import pyarrow.parquet as pq
 
             table = pq.read_table(path)
-            rows = np.column_stack([table[c].to_numpy() for c in table.column_names])
+            columns = _joint_columns(path, table.column_names, nq) or table.column_names
+            rows = np.column_stack([table[c].to_numpy() for c in columns])
         else:
             text = path.read_text(encoding="utf-8").splitlines()
-            body = text[1:] if text and not _numeric(text[0]) else text
-            rows = np.array([[float(v) for v in line.split(",")] for line in body if line.strip()])
-    except (ValueError, OSError, ImportError) as exc:
+            header = text[0].split(",") if text and not _numeric(text[0]) else None
+            lines = text[1:] if header is not None else text
+            body = [line.split(",") for line in lines if line.strip()]
+            names = [name.strip() for name in header or ()]
+            joints = _joint_columns(path, names, nq)
+            if joints:
+                body = [[cells[names.index(c)] for c in joints] for cells in body]
+            rows = np.array([[float(v) for v in cells] for cells in body])
+    except ConfigError:
+        raise  # the joint columns named, but not this robot's
+    except (ValueError, IndexError, OSError, ImportError) as exc:
         raise ConfigError("--q-file", f"{path}: not a table of numbers ({exc})") from None
     if rows.ndim != 2 or rows.shape[1] != nq or not 0 < len(rows) <= max_rows:
         raise ConfigError(
@@ -62,6 +74,21 @@ def read_q_file(path: Path, nq: int, max_rows: int = MAX_ROWS) -> np.ndarray:
             f"{path}: needs 1 to {max_rows} rows of {nq} joint values (got shape {rows.shape})",
         )
     return rows
+
+
+def _joint_columns(path: Path, names: list[str], nq: int) -> list[str] | None:
+    """q_1..q_nq when the file's columns name joints; None when they name none."""
+    joints = [name for name in names if re.fullmatch(r"q_[0-9]+", name)]
+    if not joints:
+        return None
+    wanted = [f"q_{j + 1}" for j in range(nq)]
+    if sorted(joints) != sorted(wanted):
+        raise ConfigError(
+            "--q-file",
+            f"{path}: has the joint columns {', '.join(joints)}; the scene's robot has {nq} "
+            f"joints (q_1 to q_{nq}): give a run of this robot",
+        )
+    return wanted
 
 
 def _numeric(line: str) -> bool:
@@ -87,7 +114,8 @@ def check_scene(
     Returns:
         The summary of the configuration: q [rad], ee_position [m], min_clearance [m],
         link_clearance and obstacle_clearance by name [m], self_clearance [m],
-        self_closest_pair, self_collides, self_collision_checked, collides, within_limits and
+        self_closest_pair, self_collides, self_collision_checked, collides, within_limits,
+        outside_limits (each joint outside its limits: joint, value, lower, upper [rad]) and
         metric; with `q_file`, {"configurations": [one summary per row]}.
     """
     spec = load_scene_spec(load_toml(path), str(path))
@@ -120,6 +148,8 @@ def _check(scene: Scene, itself: Scene, q: np.ndarray, metric: str) -> dict[str,
     d_self = itself.self_distances(q)
     closest = int(np.argmin(d_self)) if d_self.size else None
     self_clearance = float(d_self[closest]) if closest is not None else float("inf")
+    robot = scene.robot
+    outside = np.flatnonzero((q < robot.lower) | (q > robot.upper))
     return {
         "q": q.tolist(),
         "ee_position": scene.robot.ee_position(q).tolist(),
@@ -136,6 +166,15 @@ def _check(scene: Scene, itself: Scene, q: np.ndarray, metric: str) -> dict[str,
         "self_collides": bool(self_clearance < 0.0),
         "self_collision_checked": bool(scene.self_pairs),
         "collides": bool(min_clearance < 0.0 or (scene.self_pairs and self_clearance < 0.0)),
-        "within_limits": bool(np.all((q >= scene.robot.lower) & (q <= scene.robot.upper))),
+        "within_limits": not outside.size,
+        "outside_limits": [
+            {
+                "joint": robot.joint_names[j],
+                "value": float(q[j]),
+                "lower": float(robot.lower[j]),
+                "upper": float(robot.upper[j]),
+            }
+            for j in outside
+        ],
         "metric": metric,
     }

@@ -120,6 +120,22 @@ class TwinArm:
         self.contacts.append(most)
 
     @property
+    def periods(self) -> int:
+        """The periods every per-period list (measured, torque, contacts) holds."""
+        return min(len(self.measured), len(self.torque), len(self.contacts))
+
+    def truncate(self, periods: int) -> None:
+        """Keep only the first `periods` periods of measured, torque and contacts: a live
+        session stopped by a signal between two of their appends keeps the periods every
+        column reached. The ticks, their saturation and the peak torque keep every tick
+        played (the arm was there).
+
+        Args:
+            periods: how many periods to keep.
+        """
+        del self.measured[periods:], self.torque[periods:], self.contacts[periods:]
+
+    @property
     def speed(self) -> np.ndarray:
         """The measured joint speeds now, shape (n,) [rad/s]."""
         return self.twin.data.qvel.copy()

@@ -212,8 +212,8 @@ class Live:
     def _show(
         self, t: float, target: np.ndarray, poses: dict[str, np.ndarray], elapsed: float
     ) -> None:
-        """Record the period, and update the page every DRAW_EVERY periods (at once when the
-        planner ran over)."""
+        """Record the period (its self clearance too when the scene checks link pairs), and
+        update the page every DRAW_EVERY periods (at once when the planner ran over)."""
         scene = self.controller.planner.scene  # its obstacles are the live ones
         x = scene.robot.ee_position(self.q)
         late = elapsed > self.dt
@@ -224,10 +224,12 @@ class Live:
                 else np.full((len(scene.robot.links), 1), np.inf)
             )
             clearance = float(d.min())
+            self_clearance = float(np.min(scene.self_distances(self.q), initial=np.inf))
             self._draw(d, x, target, clearance, elapsed)
         else:
-            clearance = scene.clearances(self.q, t)[0] if scene.obstacles else np.inf
-        self.recording.add(t, self.q, x, target, clearance, poses)
+            clearance, self_clearance = scene.clearances(self.q, t)
+        checked = self_clearance if scene.self_pairs else None
+        self.recording.add(t, self.q, x, target, clearance, poses, checked)
 
     def _draw(
         self, d: np.ndarray, x: np.ndarray, target: np.ndarray, clearance: float, elapsed: float

@@ -34,6 +34,8 @@ class Recording:
         step_ms: each period's planner wall time [ms].
         measured_clearance: each period's smallest clearance of the measured arm [m] (with
             `live --plant`; empty without).
+        self_clearance: each period's smallest distance between the links of a checked
+            pair [m]; empty when the scene checks none (robot.self_collision off).
     """
 
     t: list[float] = field(default_factory=list)
@@ -44,6 +46,7 @@ class Recording:
     obstacles: dict[str, list[np.ndarray]] = field(default_factory=dict)
     step_ms: list[float] = field(default_factory=list)
     measured_clearance: list[float] = field(default_factory=list)
+    self_clearance: list[float] = field(default_factory=list)
 
     def add(
         self,
@@ -53,6 +56,7 @@ class Recording:
         target: np.ndarray,
         clearance: float,
         poses: dict[str, np.ndarray],
+        self_clearance: float | None = None,
     ) -> None:
         """Record one period.
 
@@ -63,6 +67,8 @@ class Recording:
             target: the period's target, shape (3,) [m].
             clearance: the smallest clearance there [m].
             poses: obstacle name -> its pose (4×4, world).
+            self_clearance: the smallest distance of a checked link pair there [m]; None:
+                the scene checks none.
         """
         self.t.append(t)
         self.q.append(q.copy())
@@ -72,6 +78,8 @@ class Recording:
         for name, T in poses.items():
             wxyz, position = drawing.wxyz_position(T)
             self.obstacles.setdefault(name, []).append(np.r_[position, wxyz])
+        if self_clearance is not None:
+            self.self_clearance.append(self_clearance)
 
     def write(
         self,
@@ -84,7 +92,11 @@ class Recording:
         plant: Any,
         wall_time: float,
     ) -> dict[str, Any]:
-        """The recording as a run folder `articula view` replays.
+        """The recording as a run folder `articula view` replays. A signal that ends the
+        session lands anywhere in a period, between one column's row and the next: the period
+        it cut short is left out, so every column has the same periods. The record's
+        min_self_clearance and self_collisions are those of the checked link pairs, and None,
+        as in `plan`'s record, when the scene checks none (robot.self_collision off).
 
         Args:
             folder: the run folder to write.
@@ -100,7 +112,7 @@ class Recording:
         Returns:
             The run's record (record.json).
         """
-        if not self.t:
+        if not self._keep_whole_periods(plant, bool(scene.self_pairs)):
             raise ArticulaError("--record: nothing happened yet (no control period ran)")
         x, x_ref = np.array(self.x), np.array(self.x_ref)
         run = PlanResult(
@@ -113,6 +125,7 @@ class Recording:
             1e-3 * float(np.sum(self.step_ms[1:])),
             1e-3 * self.step_ms[0],
             q0,
+            self_clearance=np.array(self.self_clearance) if scene.self_pairs else None,
         )
         metrics = tracking_metrics(run, scene.robot, 0.0, iterations)
         metrics["overrun_fraction"] = float(np.mean(np.array(self.step_ms) > 1e3 * dt))
@@ -127,3 +140,24 @@ class Recording:
         record = build_record(config, Result(metrics, {}), wall_time)
         write_run(folder, config, record, trace)
         return record
+
+    def _keep_whole_periods(self, plant: Any, self_checked: bool) -> int:
+        """Cut every per-period column (the plant's too; self_clearance when `self_checked`)
+        to the periods all of them reached.
+
+        Returns:
+            The number of periods kept.
+        """
+        columns = [self.t, self.q, self.x, self.x_ref, self.clearance, self.step_ms]
+        columns += self.obstacles.values()
+        if self_checked:
+            columns.append(self.self_clearance)
+        if plant is not None:
+            columns.append(self.measured_clearance)
+        periods = min(map(len, columns))
+        if plant is not None:
+            periods = min(periods, plant.periods)
+            plant.truncate(periods)
+        for rows in columns:
+            del rows[periods:]
+        return periods

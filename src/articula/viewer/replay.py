@@ -59,7 +59,7 @@ class Replay:
         self.run: RunData | None = None
         self.index = 0
         self.picker.on_update(lambda _: self.load(self.runs[self.picker.value]))
-        self.slider.on_update(lambda _: self.show(self._index_at(self.slider.value)))
+        self.slider.on_update(lambda _: self._time_set())
         self.trail.on_update(lambda _: self._draw_trail())
         drawing.aim_camera(server)
         self.load(runs[0])
@@ -165,6 +165,16 @@ class Replay:
         if t > run.t[-1]:
             t = float(run.t[0])  # loop
         self.slider.value = t
+        self.show(self._index_at(t))
+
+    def _time_set(self) -> None:
+        """Show the sample at the slider's time. viser hands on a time typed into its box as
+        it is, beyond the run too, and the box would keep it: such a time is put back within
+        the run (this is called again with it), so the box shows the time drawn."""
+        t = float(np.clip(self.slider.value, self.slider.min, self.slider.max))
+        if t != self.slider.value:
+            self.slider.value = t
+            return
         self.show(self._index_at(t))
 
     def _index_at(self, t: float) -> int:
