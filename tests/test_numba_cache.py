@@ -125,3 +125,16 @@ def test_jit_refreshes_the_package_cache_once_per_process(monkeypatch, fresh_ref
     jit()
     jit(error_model="numpy")
     assert calls == [()]  # the installed package, once
+
+
+def test_the_cache_is_cold_until_built_from_the_current_sources(tmp_path):
+    (tmp_path / "kernels.py").write_text("import numba\n")
+    assert numba_cache.is_cold(tmp_path)  # nothing cached
+    cache = tmp_path / "__pycache__"
+    cache.mkdir()
+    (cache / STAMP).write_text(sources_digest(tmp_path), encoding="ascii")
+    assert numba_cache.is_cold(tmp_path)  # stamped, but no kernel compiled yet
+    (cache / "kernels.total-3.py311.nbi").write_bytes(b"index")
+    assert not numba_cache.is_cold(tmp_path)
+    (tmp_path / "kernels.py").write_text("import numba  # changed\n")
+    assert numba_cache.is_cold(tmp_path)  # the next jit clears it

@@ -11,6 +11,7 @@ first compiled module is imported: `import articula` alone reads no source file.
 from __future__ import annotations
 
 import hashlib
+import os
 from collections.abc import Callable
 from functools import cache
 from pathlib import Path
@@ -64,6 +65,27 @@ def refresh_cache(root: Path = PACKAGE) -> bool:
     except OSError:
         return False  # not writable: numba then caches in its user-wide folder
     return True
+
+
+def is_cold(root: Path = PACKAGE) -> bool:
+    """Whether the next compiled call compiles from scratch: nothing cached under `root`, or
+    its numba sources changed since the cache was built (the next `jit` then clears it).
+
+    Args:
+        root: the package folder whose `__pycache__` folders hold numba's cache.
+
+    Returns:
+        True if so; False for a cache that is current, or one numba keeps elsewhere (a
+        read-only install: nothing here says).
+    """
+    stamp = root / "__pycache__" / STAMP
+    if not os.access(root, os.W_OK):
+        return False
+    try:
+        current = stamp.read_text(encoding="ascii") == sources_digest(root)
+    except OSError:
+        current = False
+    return not (current and any(root.rglob("__pycache__/*.nbi")))
 
 
 @cache

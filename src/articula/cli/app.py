@@ -69,8 +69,13 @@ def _print_version(wanted: bool) -> None:
         raise typer.Exit()
 
 
+# Commands whose first run compiles the numba kernels (about a minute on a fresh install).
+COMPILING = frozenset({"plan", "run", "sweep", "live", "view", "drive", "reproduce", "bench"})
+
+
 @app.callback()
 def _root(
+    ctx: typer.Context,
     version: Annotated[
         bool,
         typer.Option(
@@ -79,6 +84,11 @@ def _root(
     ] = False,
 ) -> None:
     """The options of `articula` itself."""
+    if ctx.invoked_subcommand in COMPILING and err.is_terminal:  # a person waits, not a log
+        from articula.numba_cache import is_cold
+
+        if is_cold():
+            err.print("compiling articula's kernels once (about a minute); later runs load them")
 
 
 def emit_json(obj: Any) -> None:
