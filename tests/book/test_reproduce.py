@@ -82,3 +82,13 @@ def test_reproduce_rejects_an_unknown_chapter_before_writing(tmp_path: Path):
     assert exc.value.field == "chapter"
     assert "ch4" in exc.value.problem
     assert not (tmp_path / "report").exists()
+
+
+def test_the_claims_table_counts_each_chapters_verdicts(reproduced_ch4):
+    from articula.cli.book import verdict_counts
+
+    _, summary = reproduced_ch4
+    details = summary["chapters"]["ch4"]["claims_detail"]
+    counts = [int(c) for c in verdict_counts(details)]
+    assert sum(counts) == len(details) > 0
+    assert counts[0] == sum(summary["chapters"]["ch4"]["claims"].values())  # reproduced

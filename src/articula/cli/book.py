@@ -18,6 +18,7 @@ from articula.cli.app import (
     emit_json,
     motor_app,
     out,
+    print_table,
     progress_bar,
 )
 
@@ -54,8 +55,27 @@ def reproduce(
         summary = run_reproduce(chapter, out_dir, full, workers, dask, step, force)
     if as_json:
         emit_json(summary)
-    else:
-        out.print(f"report written to {summary['report']}")
+        return
+    from articula.book.claims import VERDICTS
+
+    chapters = summary["chapters"].items()
+    rows = [(name, *verdict_counts(data["claims_detail"])) for name, data in chapters]
+    print_table("the book's claims", ("chapter", *VERDICTS), rows)
+    out.print(f"report written to {summary['report']}")
+
+
+def verdict_counts(details: list[dict[str, Any]]) -> tuple[str, ...]:
+    """How many of a chapter's claims have each verdict, in VERDICTS' order.
+
+    Args:
+        details: the chapter's claims_detail (each with its verdict).
+
+    Returns:
+        The counts as table cells (reproduced, not reproduced, inconclusive).
+    """
+    from articula.book.claims import VERDICTS
+
+    return tuple(str(sum(d["verdict"] == v for d in details)) for v in VERDICTS)
 
 
 @motor_app.command("analyze")
