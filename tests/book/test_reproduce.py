@@ -92,3 +92,10 @@ def test_the_claims_table_counts_each_chapters_verdicts(reproduced_ch4):
     counts = [int(c) for c in verdict_counts(details)]
     assert sum(counts) == len(details) > 0
     assert counts[0] == sum(summary["chapters"]["ch4"]["claims"].values())  # reproduced
+
+
+@pytest.mark.slow
+def test_each_chapter_is_announced_as_a_stage(tmp_path):
+    stages: list[str] = []
+    reproduce("ch4", tmp_path / "report", stage=stages.append)
+    assert stages == ["ch4, 1 of 1"]

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -38,20 +39,30 @@ def reproduce(
     dask: str | None = None,
     progress: Progress | None = None,
     force: bool = False,
+    stage: Callable[[str], None] | None = None,
 ) -> dict[str, Any]:
     """Reproduce one chapter or all of them into `out`; returns a summary with the report's
     path and, under chapters.<ch>, each chapter's numbers, claims and claims_detail.
 
     `out` must be new, empty or a report folder of articula's (`force` accepts any); it is
-    held while the chapters run.
+    held while the chapters run. `stage` is called with each chapter's name and place
+    ("ch2, 2 of 4") as it starts.
     """
     check_chapter(chapter)
     with claimed(out, "report", force):
-        return _reproduce(chapter, out, full, workers, dask, progress or no_progress)
+        return _reproduce(
+            chapter, out, full, workers, dask, progress or no_progress, stage or (lambda _: None)
+        )
 
 
 def _reproduce(
-    chapter: str, out: Path, full: bool, workers: int, dask: str | None, progress: Progress
+    chapter: str,
+    out: Path,
+    full: bool,
+    workers: int,
+    dask: str | None,
+    progress: Progress,
+    stage: Callable[[str], None],
 ) -> dict[str, Any]:
     """reproduce() inside the folder it holds."""
     chosen = list(CHAPTERS) if chapter == "all" else [chapter]
@@ -67,7 +78,8 @@ def _reproduce(
         "",
     ]
     chapters: dict[str, dict[str, Any]] = {}
-    for name in chosen:
+    for k, name in enumerate(chosen):
+        stage(f"{name}, {k + 1} of {len(chosen)}")
         study = Study(out / name, full, workers, dask, progress)
         section = importlib.import_module(f"articula.book.{name}").reproduce(study)
         chapters[name] = {**section.data, **claims_data(section.claims)}

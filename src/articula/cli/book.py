@@ -52,7 +52,10 @@ def reproduce(
         def step(done: int, total: int) -> None:
             bar.update(task, completed=done, total=total)
 
-        summary = run_reproduce(chapter, out_dir, full, workers, dask, step, force)
+        def stage(name: str) -> None:
+            bar.reset(task, total=None, description=f"reproduce {name}: runs")
+
+        summary = run_reproduce(chapter, out_dir, full, workers, dask, step, force, stage)
     if as_json:
         emit_json(summary)
         return
