@@ -228,7 +228,8 @@ static void get(const struct command *c) {
 
 static void handle(const struct command *c) {
     switch (c->kind) {
-    case HELLO:
+    case HELLO: /* a new session: its START may reuse the last one's seq (a new run) */
+        if (!running && !draining) have_last_start = 0;
         send_info();
         return;
     case START:

@@ -9,7 +9,6 @@ past the controller's 100 ms watchdog. Elsewhere they run as ordinary processes.
 
 from __future__ import annotations
 
-import contextlib
 import os
 import random
 import re
@@ -18,8 +17,7 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterator
-from functools import cache
+from collections.abc import Callable
 from pathlib import Path
 from typing import ClassVar
 
@@ -27,41 +25,27 @@ import numpy as np
 import pyarrow.parquet as pq
 import tomli_w
 
-from articula.arms.realtime import use_realtime
 from tests.arms import arm_scene
+from tests.realtime import DRIVE_PRIORITY, realtime_allowed, realtime_here
+
+__all__ = [
+    "DRIVE_PRIORITY",
+    "Fake",
+    "Process",
+    "realtime_allowed",
+    "realtime_here",
+    "rt_options",
+    "scene_file",
+]
 
 HANG = 120.0  # [s] a wait this long means the fake hangs (a guard, not a measurement)
 ROOT = Path(__file__).resolve().parents[2]
-FAKE_PRIORITY, DRIVE_PRIORITY = 20, 10  # SCHED_FIFO: the controller's cycle above the stream
-
-
-@cache
-def realtime_allowed() -> bool:
-    """Whether processes here may use SCHED_FIFO (asked of a child process)."""
-    ask = "import os; os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(1))"
-    child = subprocess.run([sys.executable, "-c", ask], capture_output=True)
-    return child.returncode == 0
+FAKE_PRIORITY = 20  # SCHED_FIFO: the controller's cycle above the stream (DRIVE_PRIORITY)
 
 
 def rt_options(priority: int) -> list[str]:
     """`--rt-priority priority` where the machine allows it, else nothing."""
     return ["--rt-priority", str(priority)] if realtime_allowed() else []
-
-
-@contextlib.contextmanager
-def realtime_here(priority: int = DRIVE_PRIORITY) -> Iterator[None]:
-    """This test process under SCHED_FIFO within the block (where allowed), for a servo
-    stream sent from the test itself; ordinary scheduling again after it."""
-    if not realtime_allowed():
-        yield
-        return
-    use_realtime(priority)
-    try:
-        yield
-    finally:
-        for task in Path("/proc/self/task").iterdir():
-            with contextlib.suppress(ProcessLookupError):
-                os.sched_setscheduler(int(task.name), os.SCHED_OTHER, os.sched_param(0))
 
 
 def environment() -> dict[str, str]:

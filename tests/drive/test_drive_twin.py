@@ -35,6 +35,7 @@ def test_the_twin_is_driven_in_real_time_and_its_folder_written(cli, tmp_path):
         (["--arm", "kuka:1.2.3.4"], "--arm"),
         (["--arm", "twin", "--rate", "333"], "--rate"),
         (["--arm", "twin", "--rt-priority", "0"], "--rt-priority"),
+        (["--arm", "twin", "--rt-priority", "100"], "--rt-priority"),
     ],
 )
 def test_a_bad_arm_or_rate_is_one_line_naming_the_option(main_fails, tmp_path, options, named):

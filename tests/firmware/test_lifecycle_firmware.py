@@ -20,6 +20,7 @@ from articula.rigs.pneunet import PneuNetPins, PneuNetRig
 from articula.rigs.programs import steps
 from articula.rigs.protocol import Kind, RigKind
 from articula.rigs.run import run_program
+from tests.rigs.test_sessions import run_sessions
 
 pytestmark = pytest.mark.firmware
 GAINS = np.array([2.0, 1.5, 0.05])
@@ -134,3 +135,9 @@ def test_another_rigs_firmware_is_refused_before_simavr_starts(built, cli):
     assert proc.stderr.splitlines() == [
         f"error: --firmware: {built / 'pneunet.elf'} is the pneunet firmware, not the motor "
         "rig's; use firmware/build/motor.elf (make -C firmware)"]  # fmt: skip
+
+
+def test_each_session_on_the_firmware_runs(emulated, tmp_path):
+    # A HELLO opens a session: the second host's START, with the first one's seq, runs.
+    _, port = emulated("motor")
+    assert run_sessions(port, tmp_path) == [500, 500, 500]

@@ -264,3 +264,12 @@ def test_rig_tune_runs_chapter_2s_other_tuners_as_in_process(emulated_pneunet, c
         here = ziegler_nichols_at_90(tuning)
         assert (result["ku"], result["tu_s"]) == pytest.approx((here.ku, here.tu), rel=1e-4)
         assert result["gains"] == pytest.approx(here.pid.tolist(), rel=1e-4)
+
+
+@pytest.mark.parametrize("command", [["run", "/dev/null", "cfg.toml"], ["record", "/dev/null",
+                                     "--duration", "1"], ["tune", "/dev/null"],
+                                     ["identify", "/dev/null"]])  # fmt: skip
+def test_an_rt_priority_out_of_range_is_one_line_naming_it(main_fails, tmp_path, command):
+    line = main_fails("rig", *command, "--out", tmp_path / "o", "--rt-priority", "0")
+    assert "--rt-priority" in line
+    assert not (tmp_path / "o").exists()

@@ -20,7 +20,7 @@ from pathlib import Path
 
 from articula.errors import ConfigError
 
-__all__ = ["scheduling", "use_realtime"]
+__all__ = ["scheduling", "use_ordinary", "use_realtime"]
 
 
 def use_realtime(priority: int, option: str = "--rt-priority") -> None:
@@ -53,6 +53,17 @@ def use_realtime(priority: int, option: str = "--rt-priority") -> None:
             "interpreter CAP_SYS_NICE (sudo setcap cap_sys_nice+ep $(readlink -f $(which "
             f"python))) or raise `ulimit -r` to {priority}; or leave the option out",
         ) from None
+
+
+def use_ordinary() -> None:
+    """Every thread of this process back under ordinary scheduling (SCHED_OTHER)."""
+    if not hasattr(os, "sched_setscheduler"):
+        return
+    for task in Path("/proc/self/task").iterdir():
+        try:
+            os.sched_setscheduler(int(task.name), os.SCHED_OTHER, os.sched_param(0))
+        except ProcessLookupError:  # a thread that ended meanwhile
+            continue
 
 
 def scheduling() -> str:

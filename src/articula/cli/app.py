@@ -56,6 +56,13 @@ Workers = Annotated[
         help="Local worker processes (default: one per core).",
     ),
 ]
+RtPriority = Annotated[
+    int | None,
+    typer.Option(
+        help="Run under real-time scheduling (SCHED_FIFO) at this priority, 1-99, so that a "
+        "busy host cannot starve the line or the stream (needs root or CAP_SYS_NICE).",
+    ),
+]
 Force = Annotated[
     bool,
     typer.Option(
@@ -150,3 +157,15 @@ def progress_bar(quiet: bool) -> Progress:
         disable=quiet or not err.is_terminal,
         transient=True,
     )
+
+
+def use_realtime(priority: int | None) -> None:
+    """Real-time scheduling for this process from now on (arms.realtime), if asked for.
+
+    Args:
+        priority: the SCHED_FIFO priority (1-99); None: ordinary scheduling.
+    """
+    if priority is not None:
+        from articula.arms.realtime import use_realtime as switch
+
+        switch(priority)

@@ -8,7 +8,7 @@ from typing import Annotated
 
 import typer
 
-from articula.cli.app import Force, OutDir, app, out
+from articula.cli.app import Force, OutDir, RtPriority, app, out
 
 
 @app.command()
@@ -34,14 +34,7 @@ def drive(
             help="The farthest a joint may start from robot.q0 [rad]; beyond, nothing moves.",
         ),
     ] = 0.05,
-    rt_priority: Annotated[
-        int | None,
-        typer.Option(
-            help="Run under real-time scheduling (SCHED_FIFO) at this priority, 1-99, once "
-            "the planner is built, so that a busy host cannot starve the stream (needs root "
-            "or CAP_SYS_NICE)."
-        ),
-    ] = None,
+    rt_priority: RtPriority = None,
     force: Force = False,
 ) -> None:
     """Drive an arm along the scene's plan in real time; writes a run folder like plan's.

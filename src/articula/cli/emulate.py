@@ -8,7 +8,7 @@ from typing import Annotated
 
 import typer
 
-from articula.cli.app import app, out
+from articula.cli.app import RtPriority, app, out, use_realtime
 
 
 @app.command()
@@ -55,14 +55,7 @@ def emulate(
     log: Annotated[
         Path | None, typer.Option(help="ur: write the controller's log here (Parquet) at the end.")
     ] = None,
-    rt_priority: Annotated[
-        int | None,
-        typer.Option(
-            help="Play the rig's (or controller's) cycle under real-time scheduling "
-            "(SCHED_FIFO) at this priority, 1-99, as a controller does (needs root or "
-            "CAP_SYS_NICE)."
-        ),
-    ] = None,
+    rt_priority: RtPriority = None,
 ) -> None:
     """Start a simulated bench rig behind a pseudo-terminal and print its device path, or
     (ur) a fake Universal Robots controller that speaks RTDE, running the scene's arm.
@@ -75,10 +68,7 @@ def emulate(
     Example: articula emulate ur --scene ur10.toml --host 127.0.0.2"""
     from articula.signals import terminate_as_interrupt
 
-    if rt_priority is not None:  # before any thread starts: they inherit it
-        from articula.arms.realtime import use_realtime
-
-        use_realtime(rt_priority)
+    use_realtime(rt_priority)  # before any thread starts: they inherit it
     if rig == "ur":
         _emulate_ur(scene, host, start, log)
         return

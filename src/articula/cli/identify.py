@@ -7,7 +7,17 @@ from typing import Annotated, Any
 
 import typer
 
-from articula.cli.app import Force, JsonFlag, OutDir, app, emit_json, out, progress_bar
+from articula.cli.app import (
+    Force,
+    JsonFlag,
+    OutDir,
+    RtPriority,
+    app,
+    emit_json,
+    out,
+    progress_bar,
+    use_realtime,
+)
 from articula.cli.rigs import Port, rig_app
 
 Window = Annotated[
@@ -50,6 +60,7 @@ def rig_identify(
     out_dir: OutDir,
     seed: Annotated[int, typer.Option(min=0, help="Noise seed of an emulated rig.")] = 0,
     encoder_window: Window = 50,
+    rt_priority: RtPriority = None,
     force: Force = False,
     as_json: JsonFlag = False,
 ) -> None:
@@ -63,6 +74,7 @@ def rig_identify(
     Example: articula rig identify /dev/ttyACM0 --out runs/ident"""
     from articula.experiments.rig_identify import identify_on_rig
 
+    use_realtime(rt_priority)
     with progress_bar(as_json) as bar:
         task = bar.add_task("excitation on the rig: parts", total=None)
         summary = identify_on_rig(

@@ -8,7 +8,16 @@ from typing import Annotated
 
 import typer
 
-from articula.cli.app import Force, JsonFlag, OutDir, emit_json, out, progress_bar
+from articula.cli.app import (
+    Force,
+    JsonFlag,
+    OutDir,
+    RtPriority,
+    emit_json,
+    out,
+    progress_bar,
+    use_realtime,
+)
 from articula.cli.rigs import Port, rig_app
 
 
@@ -34,6 +43,7 @@ def tune(
             "simulation, then confirm on the rig with a few experiments (descent only)."
         ),
     ] = None,
+    rt_priority: RtPriority = None,
     force: Force = False,
     as_json: JsonFlag = False,
 ) -> None:
@@ -47,6 +57,7 @@ def tune(
     from articula.book.ch2.rig_tuning import parse_levels, tune_into
 
     chosen = parse_levels(levels)
+    use_realtime(rt_priority)
     with progress_bar(as_json) as bar:
         task = bar.add_task(f"{method}: experiments on the rig", total=None)
         result = tune_into(

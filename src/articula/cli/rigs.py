@@ -11,11 +11,13 @@ from articula.cli.app import (
     Force,
     JsonFlag,
     OutDir,
+    RtPriority,
     app,
     emit_json,
     metric_rows,
     out,
     print_table,
+    use_realtime,
 )
 
 rig_app = typer.Typer(no_args_is_help=True, help="A bench rig on a serial port.")
@@ -51,6 +53,7 @@ def run_(
     port: Port,
     config: Annotated[Path, typer.Argument(help="An experiment config, as `articula run` takes.")],
     out_dir: OutDir,
+    rt_priority: RtPriority = None,
     force: Force = False,
     as_json: JsonFlag = False,
 ) -> None:
@@ -65,6 +68,7 @@ def run_(
     Example: articula rig run /dev/ttyACM0 runs/tuning/tuned.toml --out runs/rig"""
     from articula.experiments.rig_sessions import run_config
 
+    use_realtime(rt_priority)
     record = run_config(port, config, out_dir, force)
     model = None if record["experiment"] == "rig.record" else _on_the_model(config)
     if as_json:
@@ -92,6 +96,7 @@ def record(
     duration: Annotated[float, typer.Option(min=0.001, help="Seconds to record [s].")],
     out_dir: OutDir,
     seed: Annotated[int, typer.Option(min=0, help="Noise seed of an emulated rig.")] = 0,
+    rt_priority: RtPriority = None,
     force: Force = False,
     as_json: JsonFlag = False,
 ) -> None:
@@ -104,6 +109,7 @@ def record(
     Example: articula rig record /dev/ttyACM0 --duration 10 --out runs/record"""
     from articula.experiments.rig_sessions import record as record_rig
 
+    use_realtime(rt_priority)
     summary = record_rig(port, duration, out_dir, seed, force)
     if as_json:
         emit_json(summary)

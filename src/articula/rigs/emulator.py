@@ -270,7 +270,9 @@ class Emulator:
 
     def _execute(self, frame: Frame) -> None:
         """Carry out one command and acknowledge it."""
-        if frame.kind == Kind.HELLO:
+        if frame.kind == Kind.HELLO:  # a new session: its START may reuse the last one's seq
+            if self._run is None:
+                self._last_start = None
             self._reply(Kind.INFO, protocol.encode_info(self.device.info))
             return
         status = b""
