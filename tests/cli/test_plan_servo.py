@@ -54,6 +54,7 @@ def test_a_servo_rate_writes_the_stream_and_the_limits(cli, tmp_path, one_json):
     assert "servo at" not in line and "twin:" not in line  # only what the record has
 
 
+@pytest.mark.slow
 def test_the_line_gives_the_streams_acceleration_and_jerk_ratios(cli, tmp_path):
     scene = tmp_path / "scene.toml"
     scene.write_text(STREAMED.format(trajectory=CIRCLE, method="qp"))

@@ -160,6 +160,7 @@ def test_run_bad_config(main_fails, tmp_path, case):
     assert not (tmp_path / "out" / "record.json").exists()
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("case", ["unknown_key", "nan", "wrong_type"])
 def test_run_bad_config_console_script(cli, tmp_path, assert_one_line_error, case):
     text, names = RUN_CONFIGS[case]
@@ -208,6 +209,7 @@ def _full_disk_outcome(out) -> None:
         assert hidden_files(out) == []
 
 
+@pytest.mark.slow
 def test_a_full_disk_is_one_line_exit_1_and_no_finished_run(tmp_path, write_toml, tiny_config):
     disk = tmp_path / "disk"
     disk.mkdir()
@@ -252,6 +254,7 @@ def test_an_injected_full_disk_is_one_line_exit_1_and_no_finished_run(
     _full_disk_outcome(out)
 
 
+@pytest.mark.slow
 def test_a_folder_of_someone_elses_files_is_refused_and_left_as_it_was(
     cli, tmp_path, write_toml, tiny_config, assert_one_line_error
 ):

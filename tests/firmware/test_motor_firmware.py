@@ -50,6 +50,7 @@ def figure_config(name: str) -> CurrentControlConfig:
     return parse_model(CurrentControlConfig, data, name)
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("figure", FIGURES)
 def test_a_figures_run_on_the_firmware_agrees_with_the_simulation(figure, on_plant, tmp_path):
     config = figure_config(figure)

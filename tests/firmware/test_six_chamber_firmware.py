@@ -46,6 +46,7 @@ def both(rig: Link, tmp_path: Path, **damping: float) -> tuple[dict, dict, Recor
     return run_on_rig(config, rig, recorder), run_deactuation(config).metrics, recorder
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("damping", [{"delta": 0.0}, {"delta": 0.4, "length": 0.1}, PULSE],
                          ids=["undamped", "brief pulse", "timed pulse"])  # fmt: skip
 def test_a_run_on_the_firmware_measures_what_the_run_in_process_senses(rig, tmp_path, damping):

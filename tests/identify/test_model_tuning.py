@@ -10,6 +10,7 @@ import json
 from tests.identify.conftest import hidden_pneunet
 
 
+@pytest.mark.slow
 def test_tuning_on_the_fitted_model_needs_a_fifth_of_the_rig_experiments(
     emulate_process, cli, tmp_path
 ):

@@ -33,6 +33,7 @@ def run(method: str, task: str, **trajectory) -> dict[str, float]:
     return tracking_metrics(result, SCENE.robot, 1.0, planner.iterations, targets.cone)
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("method", ["baornn-improved", "qp", "dls", "pinv"])
 def test_a_pose_task_keeps_the_tool_axis_within_its_cone_on_a_circle(method):
     # The tool (z) axis points 36° below the horizontal at the start; asked to point

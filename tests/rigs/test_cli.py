@@ -89,6 +89,7 @@ def wait_for_samples(journal: Path, count: int, run: subprocess.Popen) -> None:
     raise AssertionError(f"the run ended first: {run.stderr.read()}")
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("ending", list(ENDINGS))
 def test_a_run_cut_short_keeps_what_came_and_says_why(pid_config, tmp_path, ending):
     options = ["--realtime", "--faults", "reset_at=1.0"] if ending == "reset" else ["--realtime"]
@@ -125,6 +126,7 @@ def test_rig_info_of_an_emulated_pneunet(emulated_pneunet, cli):
     assert "angle [deg]" in text
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(
     ("args", "words"),
     [
@@ -143,6 +145,7 @@ def test_bad_ports_and_options_are_one_line_and_exit_2(cli, args, words):
     assert len(proc.stderr.strip().splitlines()) == 1 and words in proc.stderr
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(
     "command",
     [["record", "--duration", "1"], ["tune"], ["run", str(packaged("ch4", "fig4_5.toml"))]],
@@ -155,6 +158,7 @@ def test_a_port_that_does_not_open_leaves_no_output_folder(cli, tmp_path, comman
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(
     ("content", "words"),
     [
@@ -246,6 +250,7 @@ def test_a_config_for_another_rig_is_one_line_and_exit_2(emulated_pneunet, cli, 
     assert not (tmp_path / "run").exists()  # a refused run writes nothing
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("method", ["manual", "ziegler-nichols"])
 def test_rig_tune_runs_chapter_2s_other_tuners_as_in_process(emulated_pneunet, cli, tmp_path,
                                                              method):  # fmt: skip

@@ -95,6 +95,7 @@ def test_an_unknown_plant_is_one_line_and_exit_2(scene_file, cli):
     assert len(proc.stderr.strip().splitlines()) == 1 and "--plant" in proc.stderr
 
 
+@pytest.mark.slow
 def test_the_live_page_shows_the_measured_arm(scene_file, viewer, browser, tmp_path):
     proc, url = viewer("live", scene_file, "--method", "qp", "--plant", "mujoco")
     page = open_page(browser, url, wait_for="measured: error")

@@ -74,6 +74,7 @@ def test_a_run_renders_and_the_slider_moves_the_arm(planned_run, viewer, browser
     keep_screenshot(page, "view_trail.png", tmp_path)
 
 
+@pytest.mark.slow
 def test_two_tabs_and_a_closed_browser_leave_the_server_serving(planned_run, viewer, browser):
     proc, url = viewer("view", planned_run)
     pages = [open_page(browser, url) for _ in range(2)]
@@ -98,6 +99,7 @@ def test_a_folder_without_a_run_is_one_line_and_exit_2(tmp_path, cli):
     assert len(proc.stderr.strip().splitlines()) == 1 and "RUN_DIR" in proc.stderr
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("damage", ["missing", "truncated"])
 def test_a_run_without_its_whole_record_is_refused_in_one_line(planned_run, cli, tmp_path,
                                                                damage):  # fmt: skip

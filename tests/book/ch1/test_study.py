@@ -47,6 +47,7 @@ def test_the_study_is_written_as_a_sweep_file_of_its_configs(section):
     assert len(expand_sweep(spec)) == len(_names())
 
 
+@pytest.mark.slow
 def test_running_the_study_again_recomputes_nothing(section, monkeypatch):
     from articula.book.ch1 import study
 

@@ -173,6 +173,7 @@ PARAM_FILES = {
 }
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(
     "case",
     [
@@ -203,6 +204,7 @@ BAD_ARGS = {
 }
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(
     "args",
     [["--preset", "table4.2", "--current", "2"], ["--preset", "table4.1", "--voltage", "0"]],
@@ -224,6 +226,7 @@ def _fill(args: list[str], tmp_path: Path) -> list[str]:
     return [a.format(tmp=tmp_path, good=good) for a in args]
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("case", sorted(BAD_ARGS))
 def test_motor_analyze_bad_arguments(cli, tmp_path, assert_one_line_error, case):
     args, names = BAD_ARGS[case]
