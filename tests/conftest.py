@@ -41,7 +41,9 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
         seen[key] = index = seen.get(key, 0)
         seen[key] += 1
         callspec = getattr(item, "callspec", None)
-        fast = index < keep if isinstance(keep, int) else callspec is not None and callspec.id in keep
+        fast = (
+            index < keep if isinstance(keep, int) else callspec is not None and callspec.id in keep
+        )
         if not fast:
             item.add_marker(pytest.mark.slow)
 

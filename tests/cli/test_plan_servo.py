@@ -7,6 +7,7 @@ import json
 
 import numpy as np
 import pyarrow.parquet as pq
+import pytest
 
 from articula.runs.records import is_finished
 from tests.cli.test_plan import CIRCLE, SCENE

@@ -11,6 +11,8 @@ import json
 import subprocess
 import sys
 
+import pytest
+
 from tests.firmware.conftest import FIRMWARE
 from tests.identify.conftest import (
     assert_identified,

@@ -5,6 +5,7 @@ from __future__ import annotations
 import tomllib
 
 import pyarrow.parquet as pq
+import pytest
 
 from articula.book.ch1.book_values import (
     BOOK_RUNS,
