@@ -109,6 +109,7 @@ def test_bad_plans_are_one_line_and_write_nothing(
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_a_start_inside_the_obstacle_is_refused(cli, tmp_path, assert_one_line_error):
     text = SCENE.format(trajectory=CIRCLE, method="baornn").replace(
         "position = [0.35, 0.35, 0.6]", "position = [0.0, 0.0, 1.0]"
@@ -194,6 +195,7 @@ def test_the_methods_are_really_different_planners(method_runs):
     assert len({tuple(q) for q in traces.values()}) == len(METHODS)
 
 
+@pytest.mark.slow
 def test_a_path_out_of_reach_is_one_line_and_writes_nothing(cli, tmp_path, assert_one_line_error):
     far = CIRCLE.replace("center = [0.0, 0.6, 0.5]", "center = [2.0, 0.0, 0.5]")
     out = tmp_path / "run"
@@ -204,6 +206,7 @@ def test_a_path_out_of_reach_is_one_line_and_writes_nothing(cli, tmp_path, asser
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_an_untracked_path_writes_its_folder_and_is_one_line_naming_the_tolerance(
     cli, tmp_path, assert_one_line_error
 ):

@@ -81,6 +81,7 @@ def test_a_servo_rate_that_does_not_divide_the_period_is_one_line(
     assert not (tmp_path / "run").exists()
 
 
+@pytest.mark.slow
 def test_a_servo_stream_without_the_jerk_limits_is_one_line(cli, tmp_path, assert_one_line_error):
     scene = tmp_path / "scene.toml"
     scene.write_text(SCENE.format(trajectory=CIRCLE, method="qp"))  # limits = "none"
@@ -88,6 +89,7 @@ def test_a_servo_stream_without_the_jerk_limits_is_one_line(cli, tmp_path, asser
     assert_one_line_error(proc, "planner.limits", "velocity+acceleration+jerk")
 
 
+@pytest.mark.slow
 def test_a_stream_too_long_to_hold_is_refused_before_the_run(cli, tmp_path, assert_one_line_error):
     scene = tmp_path / "scene.toml"
     limited = "[servo]\nrate = 1000\nmax_samples = 5000\n"  # 1 s of plan at 1 kHz: 1000

@@ -114,6 +114,7 @@ def test_rerunning_written_config_gives_identical_results(cli, one_json, run_dir
     assert _trace(again).equals(_trace(out))
 
 
+@pytest.mark.slow
 def test_run_human_output(cli, tmp_path, write_toml, tiny_config):
     out = tmp_path / "run"
     proc = cli("run", write_toml(tiny_config), "--out", out)
@@ -184,6 +185,7 @@ def test_run_out_is_a_file(cli, tmp_path, write_toml, tiny_config, assert_one_li
     assert_one_line_error(proc, "blocker")
 
 
+@pytest.mark.slow
 def test_run_out_under_a_file_is_one_line(
     cli, tmp_path, write_toml, tiny_config, assert_one_line_error
 ):

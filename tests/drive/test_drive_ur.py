@@ -43,7 +43,7 @@ def _wait_until_moving(fake: Fake) -> None:
     receive.disconnect()
 
 
-@pytest.mark.slow_cases(keep=("ur5",))
+@pytest.mark.slow
 @pytest.mark.parametrize("arm", ["ur10", "ur5"])
 def test_the_drive_tracks_within_2_mm_and_keeps_every_limit(tmp_path, arm):
     scene = scene_file(tmp_path, name=arm)

@@ -82,7 +82,6 @@ def test_a_jump_in_the_set_point_is_a_protective_stop(scene, tmp_path):
     assert np.max(np.abs(joints(log, "qc") - UR10_HOME)) < 1e-9  # it never moved
 
 
-@pytest.mark.slow
 def test_a_set_point_beyond_a_joint_limit_is_a_protective_stop(scene, tmp_path):
     start = [6.2, *UR10_HOME[1:]]  # shoulder_pan 0.083 rad inside its +2π limit
     fake = Fake(scene, tmp_path, start)

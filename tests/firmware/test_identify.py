@@ -34,6 +34,7 @@ def test_a_hidden_motor_is_identified_through_the_firmware(emulated, cli, tmp_pa
     assert summary["unidentifiable"] == []
 
 
+@pytest.mark.slow
 def test_a_hidden_pneunet_is_identified_through_the_firmware(emulated, cli, tmp_path):
     hidden, plant = hidden_pneunet(3, tmp_path)
     _, port = emulated("pneunet", "--plant", plant)

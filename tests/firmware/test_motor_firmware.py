@@ -90,6 +90,7 @@ def test_a_config_the_firmware_is_not_built_for_is_refused_by_field():
             update={"counts_per_rev": 500})}))  # fmt: skip
 
 
+@pytest.mark.slow
 def test_emulate_motor_with_firmware_runs_a_figure_from_the_command_line(emulated, cli, tmp_path):
     _, path = emulated("motor")
     config = packaged("ch4", "fig4_8.toml")

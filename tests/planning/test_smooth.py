@@ -216,6 +216,7 @@ def test_the_torque_rows_are_the_inverse_dynamics_of_the_twin():
         np.testing.assert_allclose(torque, twin.data.qfrc_inverse, rtol=1e-6, atol=1e-6)
 
 
+@pytest.mark.slow
 def test_the_book_circle_stays_on_the_path_under_baornn_improved():
     # Without the keep-off the redundancy drifted joint 3 to its limit and links 5 and 7 to
     # self_d_min: 0.18 mm RMS, and 22-29 mm where a constant of the stage moved by 3 %
@@ -233,6 +234,7 @@ def _plan(method: str, **planner) -> dict:
     return run_plan(parse_model(PlanConfig, data, "ur10")).metrics
 
 
+@pytest.mark.slow
 def test_the_searches_command_accelerations_as_smooth_as_qp():
     qp = _plan("qp")
     faithful = _plan("baornn", smoothing="none")

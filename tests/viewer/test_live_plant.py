@@ -64,6 +64,7 @@ def test_the_measured_arm_follows_the_commands_and_is_drawn_where_the_twin_has_i
     assert len(load_run(tmp_path / "rec").t) == 150
 
 
+@pytest.mark.slow
 def test_a_jaco_at_its_unwrapped_home_drives_the_twin_as_from_the_wrapped_pose(server, tmp_path):
     """Kinova's home reads 4.80 and 4.20 rad on the continuous joints 1 and 4: the twin starts
     at the wrapped pose and follows the commands the short way, as from the pose written

@@ -126,6 +126,7 @@ def test_a_taken_port_is_one_line_and_exit_2(planned_run, cli):
     assert np.isfinite(port)
 
 
+@pytest.mark.slow
 def test_plan_live_and_view_name_a_bad_key_alike(planned_run, cli, tmp_path):
     """One assembly (experiments.plan.build_plan): the same line, file and key, from each."""
     scene = tmp_path / "scene.toml"

@@ -23,15 +23,19 @@ TRANSFER_KEYS = {"omega/tau_ex", "omega/V", "i/tau_ex", "i/V"}
 TRANSFER_ENTRY = {"omega/tau_ex": (0, 0), "omega/V": (0, 1), "i/tau_ex": (1, 0), "i/V": (1, 1)}
 
 
-@pytest.fixture
+@pytest.fixture(scope="module")
 def analyze(cli, one_json):
-    """analyze(*args) -> the JSON object of `articula motor analyze *args --json`."""
+    """analyze(*args) -> the JSON object of `articula motor analyze *args --json`, each
+    command run once for the module (a fresh object for every caller)."""
+    done: dict[tuple[str, ...], str] = {}
 
     def run(*args: str) -> dict:
-        proc = cli("motor", "analyze", *args, "--json")
-        assert proc.returncode == 0, proc.stderr
-        assert proc.stderr == ""
-        return one_json(proc.stdout)
+        if args not in done:
+            proc = cli("motor", "analyze", *args, "--json")
+            assert proc.returncode == 0, proc.stderr
+            assert proc.stderr == ""
+            done[args] = proc.stdout
+        return one_json(done[args])
 
     return run
 
