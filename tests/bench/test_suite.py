@@ -29,7 +29,6 @@ def _check_rows(rows: list[dict]) -> None:
         assert (r["colliding_steps"] > 0) == (r["min_clearance"] <= 0)
 
 
-@pytest.mark.slow
 def test_a_suite_runs_every_method_on_every_problem_and_resumes(tmp_path, cli, one_json):
     out = tmp_path / "suite"
     args = ("bench", "suite", "--problems", "3", "--seed", "1", "--methods", "qp,pinv",

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import control
 import numpy as np
-import pytest
 
 from articula.identify.motor import MotorRecording, simulate
 from articula.plants.dc_motor import TABLE_4_1
@@ -23,7 +22,6 @@ def _recording() -> MotorRecording:
     return MotorRecording(DT, v1, zeros, zeros)
 
 
-@pytest.mark.slow
 def test_the_simulated_rig_is_python_controls_zero_order_hold_response():
     recording = _recording()
     A, B = rig_matrices(TABLE_4_1, dual=False)
