@@ -27,6 +27,27 @@ _SCRIPT = Path(sys.executable).with_name("articula")
 ARTICULA = str(_SCRIPT) if _SCRIPT.exists() else shutil.which("articula")
 
 
+@pytest.hookimpl(tryfirst=True)  # before `-m` deselects by marker
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """`@pytest.mark.slow_cases(keep=1)`: one case of a parametrized test stays in the default
+    step (`keep` first cases, or the cases whose ids `keep` names), the others are marked slow."""
+    seen: dict[str, int] = {}
+    for item in items:
+        mark = item.get_closest_marker("slow_cases")
+        if mark is None:
+            continue
+        keep = mark.kwargs.get("keep", mark.args[0] if mark.args else 1)
+        key = item.nodeid.split("[", 1)[0]
+        seen[key] = index = seen.get(key, 0)
+        seen[key] += 1
+        callspec = getattr(item, "callspec", None)
+        fast = (
+            index < keep if isinstance(keep, int) else callspec is not None and callspec.id in keep
+        )
+        if not fast:
+            item.add_marker(pytest.mark.slow)
+
+
 @pytest.fixture(scope="session")
 def articula_script() -> str:
     """Path of the installed `articula` console script."""

@@ -35,6 +35,7 @@ def test_there_are_about_ten_examples():
     assert len(EXAMPLES) >= 10
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.stem)
 def test_example_runs_at_reduced_size(script, tmp_path):
     for part in needs(script):

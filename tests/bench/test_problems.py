@@ -49,6 +49,7 @@ def test_the_start_is_clear_and_the_path_begins_at_the_end_effector(generated, t
         assert 1 <= len(scene.obstacles) <= 4
 
 
+@pytest.mark.slow
 def test_obstacles_keep_off_the_path_but_come_near_the_arm(generated, tmp_path):
     near = 0
     for problem in generated:
@@ -64,6 +65,7 @@ def test_obstacles_keep_off_the_path_but_come_near_the_arm(generated, tmp_path):
     assert near >= 2  # obstacles sit where the arm is, not anywhere in the workspace
 
 
+@pytest.mark.slow
 def test_a_problem_file_runs_with_articula_plan(generated, tmp_path, cli, one_json):
     problem = generated[0]
     for name, mesh in problem.meshes.items():
@@ -76,6 +78,7 @@ def test_a_problem_file_runs_with_articula_plan(generated, tmp_path, cli, one_js
     assert metrics["min_clearance"] > 0 and metrics["max_speed_ratio"] <= 1.0 + 1e-9
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(
     ("problem_class", "count", "gap"),
     [("tight", (2, 4), problems.TIGHT_GAP), ("grazing", (1, 2), problems.GRAZING_GAP)],

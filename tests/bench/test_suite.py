@@ -66,6 +66,7 @@ def test_a_suite_runs_every_method_on_every_problem_and_resumes(tmp_path, cli, o
     assert all(p.stat().st_mtime_ns != t for p, t in stamps.items())
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not PEERS, reason="pip install -e '.[peers]'")
 def test_mink_runs_the_same_problems(tmp_path):
     summary = suite.run_suite({"builtin": "iiwa14"}, 2, 0, tmp_path / "s",
@@ -81,6 +82,7 @@ def test_mink_runs_the_same_problems(tmp_path):
     assert qp["step_time_vs_mink"] == pytest.approx(qp["mean_step_us"] / mink["mean_step_us"])
 
 
+@pytest.mark.slow
 def test_the_tight_class_is_its_own_suite(tmp_path, cli, one_json):
     out = tmp_path / "suite"
     args = ("bench", "suite", "--problems", "2", "--methods", "qp", "--workers", "1",
@@ -93,6 +95,7 @@ def test_the_tight_class_is_its_own_suite(tmp_path, cli, one_json):
     assert (out / "problems" / "000" / "scene.toml").read_text() != first
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(
     ("options", "named"),
     [
@@ -108,6 +111,7 @@ def test_bad_options_are_one_line_and_exit_2(tmp_path, cli, options, named):
     assert len(proc.stderr.strip().splitlines()) == 1 and named in proc.stderr
 
 
+@pytest.mark.slow
 def test_the_tight_suite_on_dask_gives_the_local_numbers(tmp_path):
     # Same problems, seed and methods: the rows do not depend on the backend.
     runs = {}

@@ -11,6 +11,7 @@ pytest.importorskip("rtde_control", reason='needs ur-rtde: pip install -e ".[ur]
 pytest.importorskip("mujoco", reason='the fake runs the twin: pip install -e ".[sim]"')
 
 
+@pytest.mark.slow
 def test_drive_benchmark_prints_its_keys():
     robot_data()  # the UR10 of example-robot-data (skips without it)
     m = benchmark("drive.py", "--duration", "3")

@@ -135,6 +135,7 @@ def test_mink_keeps_d_min_past_the_bracket_with_a_damper_gain(scene_q0):
     assert max(error[-20:]) < 1e-4 and arm.infeasible == 0
 
 
+@pytest.mark.slow
 def test_peers_benchmark_prints_its_keys_as_one_json_object():
     m = benchmark("peers.py", "--steps", "50")
     keys = ["qp_step_us", "improved_step_us", "mink_step_us", "qp_vs_mink", "improved_vs_mink",
@@ -152,6 +153,7 @@ def test_peers_benchmark_prints_its_keys_as_one_json_object():
     assert m["detection_m"] < m["near_distance_m"][0] <= m["near_distance_m"][1] <= 0.6
 
 
+@pytest.mark.slow
 def test_clutter_benchmark_prints_its_keys_as_one_json_object():
     m = benchmark("clutter.py", "--steps", "40")
     assert m["obstacles"] == 50 and m["clutter_distance_m"] >= 0.2

@@ -7,9 +7,12 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
 
 
+@pytest.mark.slow
 def test_rig_link_benchmark_prints_its_keys():
     proc = subprocess.run(
         [sys.executable, str(BENCHMARKS / "rig_link.py"), "--json", "--commands", "50",

@@ -9,6 +9,7 @@ from tests.benchmarks.run import benchmark
 pytest.importorskip("mujoco", reason='the twin needs the `sim` extra: pip install -e ".[sim]"')
 
 
+@pytest.mark.slow
 def test_twin_benchmark_prints_its_keys():
     m = benchmark("twin.py")
     assert m["periods"] == 1000

@@ -53,9 +53,17 @@ def _scene(tmp_path: Path, trajectory: str = CIRCLE, method: str = "baornn") -> 
     return path
 
 
-def test_plan_writes_the_run_folder_contract(cli, tmp_path):
-    out = tmp_path / "run"
-    proc = cli("plan", _scene(tmp_path), "--out", out, "--json")
+@pytest.fixture(scope="module")
+def planned_twice(cli, tmp_path_factory):
+    """`articula plan SCENE --out a --json` and the same into b: (folder, a's proc, b's proc)."""
+    folder = tmp_path_factory.mktemp("plan")
+    scene = _scene(folder)
+    return folder, *(cli("plan", scene, "--out", folder / name, "--json") for name in "ab")
+
+
+def test_plan_writes_the_run_folder_contract(planned_twice):
+    folder, proc, _ = planned_twice
+    out = folder / "a"
     assert proc.returncode == 0, proc.stderr
     record = json.loads(proc.stdout)
     keys = {"rms_error", "max_error", "min_clearance", "collisions", "joint_limit_violations",
@@ -68,15 +76,15 @@ def test_plan_writes_the_run_folder_contract(cli, tmp_path):
     assert record["metrics"]["collisions"] == 0 and record["metrics"]["joint_limit_violations"] == 0
 
 
-def test_same_scene_same_numbers(cli, tmp_path):
-    scene = _scene(tmp_path)
-    a = json.loads(cli("plan", scene, "--out", tmp_path / "a", "--json").stdout)
-    b = json.loads(cli("plan", scene, "--out", tmp_path / "b", "--json").stdout)
+def test_same_scene_same_numbers(planned_twice):
+    folder, *procs = planned_twice
+    a, b = (json.loads(proc.stdout) for proc in procs)
     assert a["metrics"]["rms_error"] == b["metrics"]["rms_error"]
-    ta = pq.read_table(tmp_path / "a" / "trace.parquet").drop(["t"])
-    assert ta.equals(pq.read_table(tmp_path / "b" / "trace.parquet").drop(["t"]))
+    ta = pq.read_table(folder / "a" / "trace.parquet").drop(["t"])
+    assert ta.equals(pq.read_table(folder / "b" / "trace.parquet").drop(["t"]))
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(
     ("trajectory", "method", "field"),
     [
@@ -101,6 +109,7 @@ def test_bad_plans_are_one_line_and_write_nothing(
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_a_start_inside_the_obstacle_is_refused(cli, tmp_path, assert_one_line_error):
     text = SCENE.format(trajectory=CIRCLE, method="baornn").replace(
         "position = [0.35, 0.35, 0.6]", "position = [0.0, 0.0, 1.0]"
@@ -186,6 +195,7 @@ def test_the_methods_are_really_different_planners(method_runs):
     assert len({tuple(q) for q in traces.values()}) == len(METHODS)
 
 
+@pytest.mark.slow
 def test_a_path_out_of_reach_is_one_line_and_writes_nothing(cli, tmp_path, assert_one_line_error):
     far = CIRCLE.replace("center = [0.0, 0.6, 0.5]", "center = [2.0, 0.0, 0.5]")
     out = tmp_path / "run"
@@ -196,6 +206,7 @@ def test_a_path_out_of_reach_is_one_line_and_writes_nothing(cli, tmp_path, asser
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_an_untracked_path_writes_its_folder_and_is_one_line_naming_the_tolerance(
     cli, tmp_path, assert_one_line_error
 ):
@@ -223,6 +234,7 @@ def test_an_unknown_method_is_one_line_naming_planner_and_method(
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_a_plan_folder_config_reruns_bit_identically_with_articula_run(cli, tmp_path):
     first, second = tmp_path / "first", tmp_path / "second"
     assert cli("plan", _scene(tmp_path), "--out", first).returncode == 0
@@ -242,6 +254,7 @@ def _plan_sweep(tmp_path: Path) -> Path:
                                                 "grid": grid})  # fmt: skip
 
 
+@pytest.mark.slow
 def test_a_planner_sweep_gives_the_same_runs_on_a_pool_and_on_dask_and_resumes(sweep_cli, tmp_path):
     spec = _plan_sweep(tmp_path)
     pool, dask = tmp_path / "pool", tmp_path / "dask"

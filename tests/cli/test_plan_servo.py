@@ -7,6 +7,7 @@ import json
 
 import numpy as np
 import pyarrow.parquet as pq
+import pytest
 
 from articula.runs.records import is_finished
 from tests.cli.test_plan import CIRCLE, SCENE
@@ -54,6 +55,7 @@ def test_a_servo_rate_writes_the_stream_and_the_limits(cli, tmp_path, one_json):
     assert "servo at" not in line and "twin:" not in line  # only what the record has
 
 
+@pytest.mark.slow
 def test_the_line_gives_the_streams_acceleration_and_jerk_ratios(cli, tmp_path):
     scene = tmp_path / "scene.toml"
     scene.write_text(STREAMED.format(trajectory=CIRCLE, method="qp"))
@@ -81,6 +83,7 @@ def test_a_servo_rate_that_does_not_divide_the_period_is_one_line(
     assert not (tmp_path / "run").exists()
 
 
+@pytest.mark.slow
 def test_a_servo_stream_without_the_jerk_limits_is_one_line(cli, tmp_path, assert_one_line_error):
     scene = tmp_path / "scene.toml"
     scene.write_text(SCENE.format(trajectory=CIRCLE, method="qp"))  # limits = "none"
@@ -88,6 +91,7 @@ def test_a_servo_stream_without_the_jerk_limits_is_one_line(cli, tmp_path, asser
     assert_one_line_error(proc, "planner.limits", "velocity+acceleration+jerk")
 
 
+@pytest.mark.slow
 def test_a_stream_too_long_to_hold_is_refused_before_the_run(cli, tmp_path, assert_one_line_error):
     scene = tmp_path / "scene.toml"
     limited = "[servo]\nrate = 1000\nmax_samples = 5000\n"  # 1 s of plan at 1 kHz: 1000

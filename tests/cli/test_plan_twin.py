@@ -49,6 +49,7 @@ def _plan(cli, tmp_path, stiffness: str, *options: str):
     return cli("plan", scene, "--out", out, *options), out
 
 
+@pytest.mark.slow
 def test_a_stiff_twin_steps_aside_with_the_plan_and_the_line_says_how_it_tracked(cli, tmp_path):
     proc, out = _plan(cli, tmp_path, "")
     assert proc.returncode == 0, proc.stderr

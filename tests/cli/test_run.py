@@ -114,6 +114,7 @@ def test_rerunning_written_config_gives_identical_results(cli, one_json, run_dir
     assert _trace(again).equals(_trace(out))
 
 
+@pytest.mark.slow
 def test_run_human_output(cli, tmp_path, write_toml, tiny_config):
     out = tmp_path / "run"
     proc = cli("run", write_toml(tiny_config), "--out", out)
@@ -160,6 +161,7 @@ def test_run_bad_config(main_fails, tmp_path, case):
     assert not (tmp_path / "out" / "record.json").exists()
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("case", ["unknown_key", "nan", "wrong_type"])
 def test_run_bad_config_console_script(cli, tmp_path, assert_one_line_error, case):
     text, names = RUN_CONFIGS[case]
@@ -183,6 +185,7 @@ def test_run_out_is_a_file(cli, tmp_path, write_toml, tiny_config, assert_one_li
     assert_one_line_error(proc, "blocker")
 
 
+@pytest.mark.slow
 def test_run_out_under_a_file_is_one_line(
     cli, tmp_path, write_toml, tiny_config, assert_one_line_error
 ):
@@ -208,6 +211,7 @@ def _full_disk_outcome(out) -> None:
         assert hidden_files(out) == []
 
 
+@pytest.mark.slow
 def test_a_full_disk_is_one_line_exit_1_and_no_finished_run(tmp_path, write_toml, tiny_config):
     disk = tmp_path / "disk"
     disk.mkdir()
@@ -252,6 +256,7 @@ def test_an_injected_full_disk_is_one_line_exit_1_and_no_finished_run(
     _full_disk_outcome(out)
 
 
+@pytest.mark.slow
 def test_a_folder_of_someone_elses_files_is_refused_and_left_as_it_was(
     cli, tmp_path, write_toml, tiny_config, assert_one_line_error
 ):

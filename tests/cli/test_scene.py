@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 import shutil
 from pathlib import Path
@@ -41,15 +40,20 @@ def _check_json(out: dict) -> None:
     assert out["collides"] == (out["min_clearance"] < 0)
 
 
-@pytest.fixture
+@pytest.fixture(scope="module")
 def check(cli, one_json):
-    """check(*args) -> the JSON object of the real `articula scene check *args --json`."""
+    """check(*args) -> the JSON object of the real `articula scene check *args --json`, each
+    command run once for the module (a copy for every caller)."""
+    done: dict[tuple[str, ...], str] = {}
 
     def run(*args) -> dict:
-        proc = cli("scene", "check", *args, "--json")
-        assert proc.returncode == 0, proc.stderr
-        assert proc.stderr == ""
-        return one_json(proc.stdout)
+        key = tuple(map(str, args))
+        if key not in done:
+            proc = cli("scene", "check", *args, "--json")
+            assert proc.returncode == 0, proc.stderr
+            assert proc.stderr == ""
+            done[key] = proc.stdout
+        return one_json(done[key])
 
     return run
 
@@ -233,6 +237,7 @@ def test_bad_scene_file(main_fails, tmp_path, case):
         assert word in line, (word, line)
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(
     ("case", "words"),
     [
@@ -263,11 +268,11 @@ def test_relative_mesh_paths_start_at_the_scene_file(tmp_path, monkeypatch, chec
     assert moved["link_clearance"] == original["link_clearance"]
 
 
-def test_scene_check_reports_joint_limits(cli):
-    inside = json.loads(cli("scene", "check", TWO_OBSTACLES, "--json").stdout)
+def test_scene_check_reports_joint_limits(check):
+    inside = check(TWO_OBSTACLES)
     assert inside["within_limits"] is True
     q = "0,0,0,0,0,0,3.1"
-    outside = json.loads(cli("scene", "check", TWO_OBSTACLES, "--q", q, "--json").stdout)
+    outside = check(TWO_OBSTACLES, "--q", q)
     assert outside["within_limits"] is False  # joint 7 is limited to ±175° = ±3.054 rad
     (joint,) = outside["outside_limits"]
     assert (joint["joint"], joint["value"]) == ("iiwa_joint_7", 3.1)
@@ -297,6 +302,7 @@ def test_scene_check_warns_of_a_q0_outside_the_joint_limits(capsys, tmp_path):
     assert capsys.readouterr().err == ""
 
 
+@pytest.mark.slow
 def test_many_configurations_from_a_csv_or_parquet_file_give_one_row_each(cli, one_json, tmp_path):
     import pyarrow as pa
     import pyarrow.parquet as pq

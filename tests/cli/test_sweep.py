@@ -89,6 +89,7 @@ def test_process_pool_gives_identical_numbers(sweep_cli, sweep_spec, serial_swee
     assert hidden_files(out) == []
 
 
+@pytest.mark.slow
 def test_dask_local_gives_identical_numbers(sweep_cli, sweep_spec, serial_sweep, tmp_path):
     out = tmp_path / "dask"
     sweep_cli(sweep_spec, out, "--dask", "local", "--workers", "2")
@@ -96,6 +97,7 @@ def test_dask_local_gives_identical_numbers(sweep_cli, sweep_spec, serial_sweep,
     assert hidden_files(out) == []
 
 
+@pytest.mark.slow
 def test_dask_existing_scheduler_gives_identical_numbers(
     sweep_cli, sweep_spec, serial_sweep, tmp_path
 ):
@@ -152,6 +154,7 @@ def _snapshot(folder: Path) -> dict[str, tuple[int, int, bytes]]:
     }
 
 
+@pytest.mark.slow
 def test_killed_sweep_resumes_without_recomputing_finished_runs(
     sweep_cli, articula_script, tmp_path
 ):
@@ -250,6 +253,7 @@ def test_sweep_bad_spec(main_fails, tmp_path, case):
     assert not out.exists()  # a bad sweep fails before anything runs
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("case", ["bad_grid_key", "duplicate_points", "missing_file"])
 def test_sweep_bad_spec_console_script(cli, tmp_path, assert_one_line_error, case):
     text, names = SWEEP_SPECS[case]
@@ -323,6 +327,7 @@ def _wait_until(condition, seconds: float) -> bool:
     return True
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("backend", [[], ["--dask", "local"]], ids=["pool", "dask"])
 def test_a_killed_sweep_leaves_no_worker_behind(articula_script, tmp_path, backend):
     spec = write_spec(tmp_path / "slow.toml", SLOW_SPEC)
@@ -345,6 +350,7 @@ def test_a_killed_sweep_leaves_no_worker_behind(articula_script, tmp_path, backe
             os.kill(pid, signal.SIGKILL)
 
 
+@pytest.mark.slow
 def test_two_sweeps_into_one_folder_end_in_one_refusal_or_shared_results(articula_script, tmp_path):
     spec = write_spec(tmp_path / "slow.toml", SLOW_SPEC)
     out = tmp_path / "out"
@@ -367,6 +373,7 @@ def test_two_sweeps_into_one_folder_end_in_one_refusal_or_shared_results(articul
     assert hidden_files(out) == []
 
 
+@pytest.mark.slow
 def test_a_sweep_resumes_past_run_folders_that_were_left_incomplete(sweep_cli, tmp_path):
     spec = write_spec(tmp_path / "s.toml", SPEC)
     out = tmp_path / "out"

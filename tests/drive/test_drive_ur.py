@@ -44,6 +44,7 @@ def _wait_until_moving(fake: Fake) -> None:
     receive.disconnect()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("arm", ["ur10", "ur5", "ur5e"])
 def test_the_drive_tracks_within_2_mm_and_keeps_every_limit(tmp_path, arm):
     scene = scene_file(tmp_path, name=arm)
@@ -65,6 +66,7 @@ def test_the_drive_tracks_within_2_mm_and_keeps_every_limit(tmp_path, arm):
     assert np.max(np.abs(np.diff(q[-20:], axis=0))) / H < 1e-3  # at rest at the end
 
 
+@pytest.mark.slow
 def test_a_start_03_rad_off_q0_is_refused_naming_the_joint_and_nothing_moves(scene, tmp_path):
     start = list(UR10_HOME)
     start[2] += 0.3
@@ -80,6 +82,7 @@ def test_a_start_03_rad_off_q0_is_refused_naming_the_joint_and_nothing_moves(sce
     assert np.max(np.abs(qc - start)) < 1e-12
 
 
+@pytest.mark.slow
 def test_a_continuous_joint_a_turn_off_q0_is_accepted_and_driven_the_short_way(tmp_path):
     robot = ur10_robot()
     urdf = Path(robot["urdf"]).read_text()
@@ -96,6 +99,7 @@ def test_a_continuous_joint_a_turn_off_q0_is_accepted_and_driven_the_short_way(t
     assert np.min(q[:, 5]) > np.pi  # it stayed on its own turn
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("sig", "status"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
 def test_a_signal_mid_motion_brings_the_arm_to_rest_then_stops_the_program(
     scene, tmp_path, sig, status
@@ -123,6 +127,7 @@ def test_a_signal_mid_motion_brings_the_arm_to_rest_then_stops_the_program(
     assert np.max(np.abs(np.diff(joints(log, "q")[-20:], axis=0))) / H < 1e-3
 
 
+@pytest.mark.slow
 def test_a_controller_killed_mid_run_ends_the_drive_in_one_line_with_its_folder(scene, tmp_path):
     fake = Fake(scene, tmp_path)
     drive = _drive(scene, fake, tmp_path / "run")

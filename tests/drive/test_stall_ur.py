@@ -22,6 +22,7 @@ pytest.importorskip("mujoco", reason='the fake runs the twin: pip install ".[sim
 H = 0.002  # [s] the fake's cycle
 
 
+@pytest.mark.slow
 def test_a_stalled_planner_brings_the_arm_to_rest_and_stops_the_program(tmp_path: Path):
     scene = scene_file(tmp_path)
     plan = build_plan(load_plan(scene), scene.parent, str(scene))

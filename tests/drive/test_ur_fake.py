@@ -40,6 +40,7 @@ def _stream(control, q_from: np.ndarray, q_to: np.ndarray, ticks: int) -> int:
     return ticks
 
 
+@pytest.mark.slow
 def test_the_real_client_connects_and_its_servoj_stream_moves_the_twin(scene, tmp_path):
     fake = Fake(scene, tmp_path)
     control, receive = _connect(fake)
@@ -63,6 +64,7 @@ def test_the_real_client_connects_and_its_servoj_stream_moves_the_twin(scene, tm
     assert not np.any(log["contacts"])
 
 
+@pytest.mark.slow
 def test_a_jump_in_the_set_point_is_a_protective_stop(scene, tmp_path):
     fake = Fake(scene, tmp_path)
     control, receive = _connect(fake)
@@ -94,6 +96,7 @@ def test_a_set_point_beyond_a_joint_limit_is_a_protective_stop(scene, tmp_path):
     assert np.max(joints(fake.log(), "qc")[:, 0]) <= 2 * np.pi
 
 
+@pytest.mark.slow
 def test_the_program_stops_when_the_stream_stops(scene, tmp_path):
     fake = Fake(scene, tmp_path)
     control, receive = _connect(fake)

@@ -12,6 +12,7 @@ import pytest
 BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
 
 
+@pytest.mark.slow
 @pytest.mark.firmware
 def test_firmware_benchmark_prints_its_keys(built):
     proc = subprocess.run([sys.executable, str(BENCHMARKS / "firmware.py"), "--json",

@@ -11,6 +11,8 @@ import json
 import subprocess
 import sys
 
+import pytest
+
 from tests.firmware.conftest import FIRMWARE
 from tests.identify.conftest import (
     assert_identified,
@@ -21,6 +23,7 @@ from tests.identify.conftest import (
 )
 
 
+@pytest.mark.slow
 def test_a_hidden_motor_is_identified_through_the_firmware(emulated, cli, tmp_path):
     hidden, plant = hidden_motor(4, tmp_path)
     _, port = emulated("motor", "--plant", plant)
@@ -31,6 +34,7 @@ def test_a_hidden_motor_is_identified_through_the_firmware(emulated, cli, tmp_pa
     assert summary["unidentifiable"] == []
 
 
+@pytest.mark.slow
 def test_a_hidden_pneunet_is_identified_through_the_firmware(emulated, cli, tmp_path):
     hidden, plant = hidden_pneunet(3, tmp_path)
     _, port = emulated("pneunet", "--plant", plant)
@@ -39,6 +43,7 @@ def test_a_hidden_pneunet_is_identified_through_the_firmware(emulated, cli, tmp_
     assert_within(json.loads(proc.stdout)["parameters"], hidden, 0.10)
 
 
+@pytest.mark.slow
 def test_a_hidden_six_chamber_actuator_is_identified_through_firmware_built_for_it(
     built, emulate_process, cli, tmp_path
 ):

@@ -38,6 +38,7 @@ def first_frames(fd: int, count: int, timeout: float = 5.0) -> tuple[bytes, list
     return data, frames
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(("name", "rig"), [("pneunet", RigKind.PNEUNET), ("motor", RigKind.MOTOR),
                                            ("six_chamber", RigKind.SIX_CHAMBER)])  # fmt: skip
 def test_a_program_that_starts_sends_its_info_unasked(simavr, name, rig):

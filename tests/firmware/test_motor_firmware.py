@@ -50,6 +50,7 @@ def figure_config(name: str) -> CurrentControlConfig:
     return parse_model(CurrentControlConfig, data, name)
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("figure", FIGURES)
 def test_a_figures_run_on_the_firmware_agrees_with_the_simulation(figure, on_plant, tmp_path):
     config = figure_config(figure)
@@ -89,6 +90,7 @@ def test_a_config_the_firmware_is_not_built_for_is_refused_by_field():
             update={"counts_per_rev": 500})}))  # fmt: skip
 
 
+@pytest.mark.slow
 def test_emulate_motor_with_firmware_runs_a_figure_from_the_command_line(emulated, cli, tmp_path):
     _, path = emulated("motor")
     config = packaged("ch4", "fig4_8.toml")

@@ -42,6 +42,7 @@ def run(link: Link, schedule: GainSchedule, program: Program, seed: int) -> np.n
     return run_program(link, 4.0, seed)[1]
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(
     "schedule",
     [
@@ -69,6 +70,7 @@ def test_an_experiment_on_the_firmware_is_the_python_rigs_to_a_count(schedule, o
     assert m_there == pytest.approx(m_here, rel=0.02)
 
 
+@pytest.mark.slow
 def test_coordinate_descent_on_the_firmware_tunes_as_well_as_in_process(on_plant):
     config = TuningConfig(auto=AutoConfig(hold=2.0, max_iterations=6))
     levels = (30.0, 60.0)

@@ -68,6 +68,7 @@ def traced(built, tmp_path):
         rig.close()
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(("name", "count"), [("motor", 40), ("pneunet", 12), ("six_chamber", 15)])
 def test_a_stop_at_any_phase_leaves_every_output_off_by_its_ack(traced, name, count):
     rig, trace, link = traced(name)
@@ -91,6 +92,7 @@ def _spread(trials: list) -> float:
     return max(phases) - min(phases)
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("name", RIGS)
 def test_a_silent_host_stops_the_run_within_its_timeout_and_a_period(traced, name):
     rig, trace, link = traced(name)
@@ -103,6 +105,7 @@ def test_a_silent_host_stops_the_run_within_its_timeout_and_a_period(traced, nam
         assert active_now(rig, trace) == []
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("name", ["motor", "pneunet"])
 def test_a_hung_main_loop_is_caught_by_the_watchdog_and_reported(traced, name):
     rig, trace, link = traced(name)
@@ -116,6 +119,7 @@ def test_commands_in_bursts_during_a_run_lose_no_byte(traced):
     assert traffic_trial(rig, trace, link, bursts=30) == 0
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("name", RIGS)
 def test_bytes_right_behind_a_stop_a_start_or_a_run_end_are_not_lost(traced, built, name):
     _, trace, link = traced(name)

@@ -46,6 +46,7 @@ def both(rig: Link, tmp_path: Path, **damping: float) -> tuple[dict, dict, Recor
     return run_on_rig(config, rig, recorder), run_deactuation(config).metrics, recorder
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("damping", [{"delta": 0.0}, {"delta": 0.4, "length": 0.1}, PULSE],
                          ids=["undamped", "brief pulse", "timed pulse"])  # fmt: skip
 def test_a_run_on_the_firmware_measures_what_the_run_in_process_senses(rig, tmp_path, damping):
@@ -57,6 +58,7 @@ def test_a_run_on_the_firmware_measures_what_the_run_in_process_senses(rig, tmp_
     assert there["settling_s"] == pytest.approx(here["settling_s"], abs=0.0101)  # a frame
 
 
+@pytest.mark.slow
 def test_the_policy_found_in_simulation_damps_the_firmware_rig_the_same_way(rig, tmp_path):
     off_there, off_here, _ = both(rig, tmp_path / "off", delta=0.0)
     on_there, on_here, _ = both(rig, tmp_path / "on", **PULSE)
@@ -83,6 +85,7 @@ def test_the_fill_table_in_the_firmware_is_the_models():
     assert HEADER.read_text() == fill_table_header(SixChamberParams())
 
 
+@pytest.mark.slow
 def test_emulate_six_chamber_with_firmware_runs_from_the_command_line(emulated, cli, tmp_path):
     config = tmp_path / "damping.toml"
     config.write_text('experiment = "softarm.damping"\nseed = 4\nhold = 1.0\nafter = 1.0\n'

@@ -42,6 +42,7 @@ def plan_cases() -> st.SearchStrategy[PlanCase]:
     return st.one_of(scene, scene, scene, out)  # an odd --out in a quarter of the examples
 
 
+@pytest.mark.slow
 @FUZZ_SETTINGS
 @given(case=plan_cases())
 @example(case=PlanCase("baornn-circle", set_(("obstacles", 0, "scale"), 1e308)))
@@ -125,6 +126,7 @@ def scene_cases() -> st.SearchStrategy[SceneCase]:
     return st.one_of(scene, q, metric)
 
 
+@pytest.mark.slow
 @FUZZ_SETTINGS
 @given(case=scene_cases())
 @example(case=SceneCase("builtin", set_(("obstacles", 0, "scale"), 1e308)))

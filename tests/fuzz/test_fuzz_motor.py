@@ -80,6 +80,7 @@ def motor_cases() -> st.SearchStrategy[MotorCase]:
     )
 
 
+@pytest.mark.slow
 @FUZZ_SETTINGS
 @given(case=motor_cases())
 @example(case=MotorCase(value="1e308"))

@@ -73,6 +73,7 @@ def reproduce_cases() -> st.SearchStrategy[ReproduceCase]:
     )  # fmt: skip
 
 
+@pytest.mark.slow
 @FUZZ_SETTINGS
 @given(case=reproduce_cases())
 @example(case=ReproduceCase("ch9", ()))

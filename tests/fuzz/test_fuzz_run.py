@@ -74,6 +74,7 @@ def check_run(fuzz: Fuzz, base: dict[str, Any], case: RunCase) -> None:
     )  # fmt: skip
 
 
+@pytest.mark.slow
 @FUZZ_SETTINGS
 @given(case=cases(bases.MOTOR_CURRENT))
 @example(case=RunCase(set_(("reference", "current"), -1e308)))
@@ -83,6 +84,7 @@ def test_run_motor_current(fuzz: Fuzz, case: RunCase):
     check_run(fuzz, bases.MOTOR_CURRENT, case)
 
 
+@pytest.mark.slow
 @FUZZ_SETTINGS
 @given(case=cases(bases.PNEUNET_PID))
 @example(case=RunCase(set_(("duration",), 1e9)))
@@ -91,6 +93,7 @@ def test_run_pneunet_pid(fuzz: Fuzz, case: RunCase):
     check_run(fuzz, bases.PNEUNET_PID, case)
 
 
+@pytest.mark.slow
 @FUZZ_SETTINGS
 @given(case=cases(bases.SOFTARM_DAMPING))
 @example(case=RunCase(set_(("dt",), 1e-12)))
@@ -100,6 +103,7 @@ def test_run_softarm_damping(fuzz: Fuzz, case: RunCase):
     check_run(fuzz, bases.SOFTARM_DAMPING, case)
 
 
+@pytest.mark.slow
 @FUZZ_SETTINGS
 @given(case=cases(bases.PLANS["baornn-circle"]))
 @example(case=RunCase(set_(("planner", "duration"), 1e9)))

@@ -81,6 +81,7 @@ def sweep_cases() -> st.SearchStrategy[SweepCase]:
     )  # fmt: skip
 
 
+@pytest.mark.slow
 @FUZZ_SETTINGS
 @given(case=sweep_cases())
 @example(case=SweepCase(set_(("runs",), [])))

@@ -229,6 +229,7 @@ def test_random_bytes_in_an_stl_are_a_geometry_error_not_a_missing_module(tmp_pa
     assert "No module named" not in str(exc.value)
 
 
+@pytest.mark.slow
 def test_a_decomposition_is_cached_by_content_and_threshold(monkeypatch, decomposition_cache):
     import coacd
 

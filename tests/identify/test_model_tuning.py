@@ -7,9 +7,12 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from tests.identify.conftest import hidden_pneunet
 
 
+@pytest.mark.slow
 def test_tuning_on_the_fitted_model_needs_a_fifth_of_the_rig_experiments(
     emulate_process, cli, tmp_path
 ):

@@ -16,6 +16,7 @@ from articula.identify.motor import MotorRecording
 from tests.identify.conftest import assert_identified, hidden_motor
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [1, 2, 3])
 def test_a_hidden_motor_is_identified_through_the_line(seed, emulate_process, cli, tmp_path):
     hidden, plant = hidden_motor(seed, tmp_path)

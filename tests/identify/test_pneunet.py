@@ -15,6 +15,7 @@ from articula.experiments.rig_identify import PNEUNET_EXCITATION, SAFE_PWM
 from tests.identify.conftest import assert_within, hidden_pneunet
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [1, 2])
 def test_a_hidden_pneunet_is_identified_through_the_line(seed, emulate_process, cli, tmp_path):
     hidden, plant = hidden_pneunet(seed, tmp_path)

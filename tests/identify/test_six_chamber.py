@@ -15,6 +15,7 @@ from articula.experiments.six_chamber_on_rig import plant_config
 from tests.identify.conftest import assert_within, hidden_six_chamber
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [1, 2])
 def test_a_hidden_six_chamber_actuator_is_identified_through_the_line(
     seed, emulate_process, cli, tmp_path

@@ -53,6 +53,7 @@ def _within_limits(q: np.ndarray) -> None:
     assert np.all(np.abs(np.diff(motion, axis=0)) <= ROBOT.acceleration_limit * DT**2 * (1 + 1e-9))
 
 
+@pytest.mark.slow_cases(keep=("qp",))
 @pytest.mark.parametrize("method", ["qp", "baornn-improved"])
 def test_a_lagging_servo_is_brought_onto_the_path_within_every_limit(method):
     run = _servo_run(method, 10.0)

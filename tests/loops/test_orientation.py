@@ -33,6 +33,7 @@ def run(method: str, task: str, **trajectory) -> dict[str, float]:
     return tracking_metrics(result, SCENE.robot, 1.0, planner.iterations, targets.cone)
 
 
+@pytest.mark.slow_cases(keep=("qp",))
 @pytest.mark.parametrize("method", ["baornn-improved", "qp", "dls", "pinv"])
 def test_a_pose_task_keeps_the_tool_axis_within_its_cone_on_a_circle(method):
     # The tool (z) axis points 36° below the horizontal at the start; asked to point
@@ -52,6 +53,7 @@ def test_a_pose_task_keeps_the_tool_axis_within_its_cone_on_a_circle(method):
     assert m["min_self_clearance"] >= SCENE.self_d_min - 1e-6
 
 
+@pytest.mark.slow_cases(keep=("qp-0.0001-0.001",))
 @pytest.mark.parametrize(
     ("method", "position", "turn"), [("qp", 1e-4, 1e-3), ("baornn-improved", 5e-3, 0.05)]
 )

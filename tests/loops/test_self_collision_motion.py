@@ -34,6 +34,7 @@ def fold(method: str, self_collision: bool) -> tuple[float, float]:
     return min(judge.self_clearance(q) for q in run.q), float(run.error[-1])
 
 
+@pytest.mark.slow_cases(keep=("qp",))
 @pytest.mark.parametrize("method", ["baornn-improved", "qp"])
 def test_self_collision_stops_a_motion_that_folds_the_arm_into_itself(method):
     unchecked, _ = fold(method, self_collision=False)

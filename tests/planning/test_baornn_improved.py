@@ -53,6 +53,7 @@ def test_improved_same_seed_is_bit_identical_and_seeds_differ(objective):
     assert not np.array_equal(a.q, c.q)
 
 
+@pytest.mark.slow
 def test_improved_beats_the_faithful_baornn_with_a_penalty_on_every_seed(objective):
     # Λ > 0 keeps g >= Λ/d, so the faithful antennae (c1·√g) never shrink near the path.
     q0 = np.zeros(ROBOT.nq)
@@ -67,6 +68,7 @@ def test_improved_beats_the_faithful_baornn_with_a_penalty_on_every_seed(objecti
         assert b.clearance.min() > objective.d_min
 
 
+@pytest.mark.slow
 def test_short_antennae_refine_what_the_long_ones_overshoot(objective):
     # short_antenna = 1 is the variant without change 4: every pair as long as λ_k.
     q0 = np.zeros(ROBOT.nq)

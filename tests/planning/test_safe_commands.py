@@ -48,6 +48,7 @@ def assert_within_every_limit(result: Result, config: PlanConfig) -> None:
     assert np.all(trace["self_clearance"] > 0.0) and result.metrics["self_collisions"] == 0
 
 
+@pytest.mark.slow_cases(keep=("qp-circle_two_obstacles",))
 @pytest.mark.parametrize("scene", BOOK)
 @pytest.mark.parametrize("method", METHODS)
 def test_book_scenes_are_planned_within_every_limit(scene, method):
@@ -62,6 +63,7 @@ def test_book_scenes_are_planned_within_every_limit(scene, method):
         assert m["rms_error"] <= 0.0005
 
 
+@pytest.mark.slow_cases(keep=("qp-panda",))
 @pytest.mark.parametrize("arm", ["panda", "xarm"])
 @pytest.mark.parametrize("method", METHODS)
 def test_a_panda_and_an_xarm_are_planned_within_every_limit(arm, method):
@@ -78,6 +80,7 @@ def test_a_panda_and_an_xarm_are_planned_within_every_limit(arm, method):
         assert result.metrics["min_clearance"] > 0.0
 
 
+@pytest.mark.slow_cases(keep=("qp",))
 @pytest.mark.parametrize("method", METHODS)
 def test_a_motion_that_would_fold_the_panda_stops_at_self_d_min(method):
     """The tool is sent to a point inside the arm's own base column: each method stops

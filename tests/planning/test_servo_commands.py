@@ -63,6 +63,7 @@ def assert_streamed_within_every_limit(result: Result, config: PlanConfig) -> No
         assert m["min_self_clearance"] >= config.robot.self_d_min - 1e-6
 
 
+@pytest.mark.slow_cases(keep=("qp-circle_two_obstacles",))
 @pytest.mark.parametrize("scene", BOOK)
 @pytest.mark.parametrize("method", METHODS)
 def test_book_scenes_stream_within_every_limit(scene, method):
@@ -70,6 +71,7 @@ def test_book_scenes_stream_within_every_limit(scene, method):
     assert_streamed_within_every_limit(result, config)
 
 
+@pytest.mark.slow_cases(keep=("qp",))
 @pytest.mark.parametrize("method", METHODS)
 def test_a_panda_streams_within_every_limit(method):
     result, config = streamed(arm_scene("panda"), method)

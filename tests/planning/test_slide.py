@@ -133,6 +133,7 @@ def held_at_self_d_min(tmp_path):
             "folder": str(tmp_path / "p16")}  # fmt: skip
 
 
+@pytest.mark.slow
 def test_baornn_improved_slides_along_self_d_min_where_its_search_alone_is_held(
     held_at_self_d_min, monkeypatch
 ):

@@ -231,6 +231,7 @@ def test_torques_are_known_only_with_inertias_and_an_effort_limit():
     assert not torques_known(massless)
 
 
+@pytest.mark.slow
 def test_the_book_circle_stays_on_the_path_under_baornn_improved():
     # Without the keep-off the redundancy drifted joint 3 to its limit and links 5 and 7 to
     # self_d_min: 0.18 mm RMS, and 22-29 mm where a constant of the stage moved by 3 %
@@ -248,6 +249,7 @@ def _plan(method: str, **planner) -> dict:
     return run_plan(parse_model(PlanConfig, data, "ur10")).metrics
 
 
+@pytest.mark.slow
 def test_the_searches_command_accelerations_as_smooth_as_qp():
     qp = _plan("qp")
     faithful = _plan("baornn", smoothing="none")

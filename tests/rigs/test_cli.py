@@ -89,6 +89,7 @@ def wait_for_samples(journal: Path, count: int, run: subprocess.Popen) -> None:
     raise AssertionError(f"the run ended first: {run.stderr.read()}")
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("ending", list(ENDINGS))
 def test_a_run_cut_short_keeps_what_came_and_says_why(pid_config, tmp_path, ending):
     options = ["--realtime", "--faults", "reset_at=1.0"] if ending == "reset" else ["--realtime"]
@@ -115,6 +116,7 @@ def test_a_run_cut_short_keeps_what_came_and_says_why(pid_config, tmp_path, endi
     assert 10 < rows == record["samples"] < 240
 
 
+@pytest.mark.slow
 def test_rig_info_of_an_emulated_pneunet(emulated_pneunet, cli):
     proc = cli("rig", "info", emulated_pneunet, "--json")
     assert proc.returncode == 0, proc.stderr
@@ -125,6 +127,7 @@ def test_rig_info_of_an_emulated_pneunet(emulated_pneunet, cli):
     assert "angle [deg]" in text
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(
     ("args", "words"),
     [
@@ -143,6 +146,7 @@ def test_bad_ports_and_options_are_one_line_and_exit_2(cli, args, words):
     assert len(proc.stderr.strip().splitlines()) == 1 and words in proc.stderr
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(
     "command",
     [["record", "--duration", "1"], ["tune"], ["run", str(packaged("ch4", "fig4_5.toml"))]],
@@ -155,6 +159,7 @@ def test_a_port_that_does_not_open_leaves_no_output_folder(cli, tmp_path, comman
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("content", "words"),
     [
@@ -177,6 +182,7 @@ def test_a_firmware_file_that_is_not_the_rigs_is_refused_naming_it(cli, tmp_path
     assert f"error: --firmware: {elf} {words}" in proc.stderr
 
 
+@pytest.mark.slow
 def test_a_recording_runs_again_from_its_config(emulated_pneunet, cli, tmp_path):
     settings = tmp_path / "pid.toml"
     settings.write_text(PID_CONFIG)  # leaves its gains and sinusoid on the rig
@@ -195,6 +201,7 @@ def test_a_recording_runs_again_from_its_config(emulated_pneunet, cli, tmp_path)
     assert traces[0] == traces[1] and len(traces[0]["t"]) == 30
 
 
+@pytest.mark.slow
 def test_rig_tune_reaches_the_in_process_gains(emulated_pneunet, cli, tmp_path):
     config = tmp_path / "tuning.toml"
     config.write_text("[auto]\nseed = 2000\nhold = 2.0\nmax_iterations = 5\n")
@@ -209,6 +216,7 @@ def test_rig_tune_reaches_the_in_process_gains(emulated_pneunet, cli, tmp_path):
     assert json.loads((tmp_path / "tune" / "tuning.json").read_text()) == result
 
 
+@pytest.mark.slow
 def test_rig_record_takes_every_channel(emulated_pneunet, cli, tmp_path):
     proc = cli("rig", "record", emulated_pneunet, "--duration", "2", "--out", tmp_path / "rec",
                "--json")  # fmt: skip
@@ -218,6 +226,7 @@ def test_rig_record_takes_every_channel(emulated_pneunet, cli, tmp_path):
     assert list(trace) == ["t", "reference", "angle", "pwm"]
 
 
+@pytest.mark.slow
 def test_rig_run_of_fig_4_6_on_the_emulated_motor_rig_is_articula_run(cli, tmp_path):
     config = packaged("ch4", "fig4_6.toml")
     proc = subprocess.Popen([ARTICULA, "emulate", "motor", "--plant", str(config)],
@@ -237,6 +246,7 @@ def test_rig_run_of_fig_4_6_on_the_emulated_motor_rig_is_articula_run(cli, tmp_p
         assert rig["metrics"][key] == expected, key
 
 
+@pytest.mark.slow
 def test_a_config_for_another_rig_is_one_line_and_exit_2(emulated_pneunet, cli, tmp_path):
     proc = cli("rig", "run", emulated_pneunet, packaged("ch4", "fig4_5.toml"), "--out",
                tmp_path / "run")  # fmt: skip
@@ -246,6 +256,7 @@ def test_a_config_for_another_rig_is_one_line_and_exit_2(emulated_pneunet, cli, 
     assert not (tmp_path / "run").exists()  # a refused run writes nothing
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["manual", "ziegler-nichols"])
 def test_rig_tune_runs_chapter_2s_other_tuners_as_in_process(emulated_pneunet, cli, tmp_path,
                                                              method):  # fmt: skip

@@ -52,6 +52,7 @@ def hostile():
         proc.wait(10)
 
 
+@pytest.mark.slow_cases(keep=("flood-run",))
 @pytest.mark.parametrize("command", ["run", "record"])
 @pytest.mark.parametrize("mode", list(MODES))
 def test_a_hostile_device_ends_the_command_with_one_line_and_exit_1(hostile, cli, tmp_path,

@@ -108,6 +108,7 @@ def test_bad_faults_name_the_problem(text, error):
         Faults.parse(text)
 
 
+@pytest.mark.slow
 def test_coordinate_descent_over_the_line_tunes_as_in_process():
     # Chapter 2's tuner, unchanged, on the emulated rig: the same program, the same seeds.
     config = TuningConfig(auto=AutoConfig(hold=2.0, max_iterations=6))

@@ -25,6 +25,7 @@ def figure_config(name: str) -> CurrentControlConfig:
     return parse_model(CurrentControlConfig, data, name)
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("figure", ["fig4_5", "fig4_6", "fig4_7", "fig4_8", "fig4_9"])
 def test_a_figures_run_on_the_emulated_rig_has_the_in_process_metrics(figure, tmp_path):
     config = figure_config(figure)

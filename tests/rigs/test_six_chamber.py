@@ -26,6 +26,7 @@ def rig():
         yield link
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("delta", [0.0, 0.4])
 def test_a_run_on_the_rig_measures_what_the_run_in_process_senses(rig, tmp_path, delta):
     config = DeactuationConfig(seed=4, hold=1.0, after=1.5,

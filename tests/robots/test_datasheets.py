@@ -185,6 +185,7 @@ def test_a_datasheet_for_another_number_of_joints_is_refused():
         datasheet("kinova-gen3", 6)
 
 
+@pytest.mark.slow_cases(keep=("qp",))
 @pytest.mark.parametrize("method", METHODS)
 def test_a_panda_is_commanded_within_franka_s_published_limits(method):
     """Every method on the Panda tight scene with the jerk limits kept: every commanded

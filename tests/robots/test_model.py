@@ -358,6 +358,7 @@ def _chain_urdf(links: int) -> str:
     return f'<robot name="r">{body}</robot>'
 
 
+@pytest.mark.slow
 def test_a_urdf_over_the_link_limit_is_refused_before_pinocchio_reads_it(tmp_path):
     path = tmp_path / "long.urdf"
     path.write_text(_chain_urdf(300))

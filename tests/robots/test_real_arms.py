@@ -162,6 +162,7 @@ def test_panda_forward_kinematics_agrees_with_pybullet(bullet):
     assert worst < 1e-6  # [m] and rotation entries; measured 2.5e-7 (pybullet's quaternions)
 
 
+@pytest.mark.slow_cases(keep=("qp-extra0",))
 @pytest.mark.parametrize(
     ("method", "extra"),
     [

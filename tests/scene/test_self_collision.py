@@ -44,6 +44,7 @@ def link_points(q: np.ndarray, name: str) -> list[np.ndarray]:
     return out
 
 
+@pytest.mark.slow
 def test_self_distances_match_a_brute_force_hull_distance_on_random_configurations():
     pairs = [(a, b) for i, a in enumerate(LINKS) for b in LINKS[i + 2 :]]  # not adjacent
     scene = Scene(ROBOT, [], self_pairs=pairs)

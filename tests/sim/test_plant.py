@@ -90,6 +90,7 @@ def twin_runs():
     return run
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(
     ("scene", "method"),
     [
@@ -108,6 +109,7 @@ def test_the_twin_touches_nothing_within_its_effort_limits(twin_runs, scene, met
     assert clearance > 0.0 and m["plant_min_clearance"] > 0.0
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(
     ("scene", "method"),
     [

@@ -37,6 +37,7 @@ def _joints(trace: dict, name: str) -> np.ndarray:
     return np.column_stack([trace[f"{name}_{j + 1}"] for j in range(6)])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["qp", "baornn-improved"])
 def test_a_jaco_at_its_unwrapped_home_tracks_as_from_the_wrapped_pose(method):
     assert np.max(np.abs(np.array(WRAPPED_HOME))) < np.pi  # the same pose, written wrapped

@@ -37,6 +37,7 @@ def server():
     s.stop()
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("method", ["qp", "baornn-improved"])
 def test_an_obstacle_pushed_into_the_arm_is_avoided(server, scene_file, tmp_path, method):
     live = Live(server, LiveScene.load(scene_file, method))
@@ -99,6 +100,7 @@ def test_the_panel_rebuilds_the_controller_and_refuses_a_start_within_d_min(serv
     assert "not changed" not in live.readout.content
 
 
+@pytest.mark.slow
 def test_the_live_page_renders_in_two_tabs_and_ctrl_c_writes_the_record(
     scene_file, viewer, browser, tmp_path
 ):
@@ -117,6 +119,7 @@ def test_the_live_page_renders_in_two_tabs_and_ctrl_c_writes_the_record(
     assert len(run.t) > 10 and run.clearance.min() > 0
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(
     ("change", "field"),
     [({"d_min": -1.0}, "d_min"), ({"d_min": 5.0}, "d_min")],

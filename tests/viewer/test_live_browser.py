@@ -68,6 +68,7 @@ def project(camera, point: np.ndarray) -> tuple[float, float]:
     return (x + 1) / 2 * VIEWPORT[0], (1 - y) / 2 * VIEWPORT[1]
 
 
+@pytest.mark.slow
 def test_dragging_the_goal_marker_stops_the_following_and_the_tool_goes_there(live_page, tmp_path):
     live, page = live_page
     camera = next(iter(live.server.get_clients().values())).camera
@@ -102,6 +103,7 @@ def test_dragging_the_goal_marker_stops_the_following_and_the_tool_goes_there(li
     assert np.all(acceleration <= robot.acceleration_limit * (1 + 1e-9))
 
 
+@pytest.mark.slow
 def test_a_refused_setting_typed_in_stays_visible_and_the_box_shows_the_one_in_force(
     live_page,
 ):

@@ -69,6 +69,7 @@ def test_the_measured_arm_follows_the_commands_and_is_drawn_where_the_twin_has_i
     assert len(load_run(tmp_path / "rec").t) == 150
 
 
+@pytest.mark.slow
 def test_a_jaco_at_its_unwrapped_home_drives_the_twin_as_from_the_wrapped_pose(server, tmp_path):
     """Kinova's home reads 4.80 and 4.20 rad on the continuous joints 1 and 4: the twin starts
     at the wrapped pose and follows the commands the short way, as from the pose written
@@ -100,6 +101,7 @@ def test_an_unknown_plant_is_one_line_and_exit_2(scene_file, cli):
     assert len(proc.stderr.strip().splitlines()) == 1 and "--plant" in proc.stderr
 
 
+@pytest.mark.slow
 def test_the_live_page_shows_the_measured_arm(scene_file, viewer, browser, tmp_path):
     proc, url = viewer("live", scene_file, "--method", "qp", "--plant", "mujoco")
     page = open_page(browser, url, wait_for="measured: error")

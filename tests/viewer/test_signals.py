@@ -20,6 +20,7 @@ LINES = {
 }
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(("sent", "status"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
 def test_live_writes_its_record_on_sigterm_as_on_ctrl_c(scene_file, viewer, tmp_path, sent,
                                                         status):  # fmt: skip
@@ -31,6 +32,7 @@ def test_live_writes_its_record_on_sigterm_as_on_ctrl_c(scene_file, viewer, tmp_
     assert len(run.t) >= 1
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("sent", "status"), [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
 def test_view_ends_with_the_signals_status(planned_run, viewer, sent, status):
     proc, _ = viewer("view", planned_run)

@@ -90,6 +90,7 @@ def test_a_time_typed_beyond_the_run_is_put_back_in_the_box(planned_run, viewer,
         page.get_by_text(f"t = {shown:.2f} s").wait_for(timeout=30_000)
 
 
+@pytest.mark.slow
 def test_two_tabs_and_a_closed_browser_leave_the_server_serving(planned_run, viewer, browser):
     proc, url = viewer("view", planned_run)
     pages = [open_page(browser, url) for _ in range(2)]
@@ -114,6 +115,7 @@ def test_a_folder_without_a_run_is_one_line_and_exit_2(tmp_path, cli):
     assert len(proc.stderr.strip().splitlines()) == 1 and "RUN_DIR" in proc.stderr
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("damage", ["missing", "truncated"])
 def test_a_run_without_its_whole_record_is_refused_in_one_line(planned_run, cli, tmp_path,
                                                                damage):  # fmt: skip
@@ -140,6 +142,7 @@ def test_a_taken_port_is_one_line_and_exit_2(planned_run, cli):
     assert np.isfinite(port)
 
 
+@pytest.mark.slow
 def test_plan_live_and_view_name_a_bad_key_alike(planned_run, cli, tmp_path):
     """One assembly (experiments.plan.build_plan): the same line, file and key, from each."""
     scene = tmp_path / "scene.toml"

@@ -5,10 +5,16 @@ from __future__ import annotations
 import json
 import re
 
+import pytest
+
 from articula.book.ch1 import report
 from articula.book.ch1.analysis import AVERAGED
 from articula.book.ch1.book_values import BOOK_RUNS, METHODS, SCENES, SNAPSHOTS
 from articula.book.ch1.study import Ch1Results
+
+# Every test here reads the chapter-1 study run once (conftest.py's `section`, about 25 s);
+# chapter 4's run (tests/book/conftest.py) stands for a study in the default step.
+pytestmark = pytest.mark.slow
 
 HEADINGS = (
     "### Figs. 1.4-1.12: the faithful BAORNN (Algorithm 1)",

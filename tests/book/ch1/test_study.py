@@ -5,6 +5,7 @@ from __future__ import annotations
 import tomllib
 
 import pyarrow.parquet as pq
+import pytest
 
 from articula.book.ch1.book_values import (
     BOOK_RUNS,
@@ -26,6 +27,7 @@ def _names() -> list[str]:
     return [r.name for r in (*BOOK_RUNS, *comparison_runs(False))]
 
 
+@pytest.mark.slow
 def test_every_run_was_planned_once_shortened_and_written(section):
     names = _names()
     assert sorted(section["configs"]) == sorted(names)
@@ -42,11 +44,13 @@ def test_every_run_was_planned_once_shortened_and_written(section):
     assert {total for _, total in section["ticks"]} == {len(names)}
 
 
+@pytest.mark.slow
 def test_the_study_is_written_as_a_sweep_file_of_its_configs(section):
     spec = tomllib.loads((section["out"] / SWEEP).read_text())
     assert len(expand_sweep(spec)) == len(_names())
 
 
+@pytest.mark.slow
 def test_running_the_study_again_recomputes_nothing(section, monkeypatch):
     from articula.book.ch1 import study
 
@@ -57,6 +61,7 @@ def test_running_the_study_again_recomputes_nothing(section, monkeypatch):
     assert after == written
 
 
+@pytest.mark.slow
 def test_the_book_runs_without_a_penalty_also_drop_d_min(section):
     # Sect. 1.4.1 runs Λ = 0 "ignoring the 2nd constraint": d_min = 0 as well.
     for run in BOOK_RUNS:
@@ -68,6 +73,7 @@ def test_the_book_runs_without_a_penalty_also_drop_d_min(section):
             assert planner["lambda_weight"] > 0 and planner["d_min"] > 0, run.name
 
 
+@pytest.mark.slow
 def test_the_data_runs_are_the_records_of_the_book_runs(section):
     runs = section["section"].data["runs"]
     assert set(runs) == {r.name for r in BOOK_RUNS}

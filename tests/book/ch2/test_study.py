@@ -40,6 +40,7 @@ def ch2(cli, one_json, tmp_path_factory):
     return out, one_json(proc.stdout)
 
 
+@pytest.mark.slow
 def test_json_has_table_2_3(ch2):
     data = ch2[1]["chapters"]["ch2"]
     assert sorted(data["table_2_3"]) == sorted(CONTROLLERS)
@@ -49,6 +50,7 @@ def test_json_has_table_2_3(ch2):
             assert 0 <= q1 <= median <= q3 <= 90
 
 
+@pytest.mark.slow
 def test_json_has_table_2_2(ch2):
     data = ch2[1]["chapters"]["ch2"]
     assert sorted(data["table_2_2"]) == ["auto", "manual"]
@@ -58,6 +60,7 @@ def test_json_has_table_2_2(ch2):
         assert set(gains) == {"kp", "ki", "kd"} and min(gains.values()) >= 0
 
 
+@pytest.mark.slow
 def test_json_has_the_claims_by_name(ch2):
     data = ch2[1]["chapters"]["ch2"]
     assert set(data["claims"]) == set(CLAIMS) == {
@@ -71,6 +74,7 @@ def test_json_has_the_claims_by_name(ch2):
         assert data["claims"][name] == (claim["verdict"] == "reproduced")
 
 
+@pytest.mark.slow
 def test_report_section_has_the_books_numbers_and_the_claims(ch2):
     text = (ch2[0] / "report.md").read_text()
     assert "## Chapter 2: PID control of a soft bending actuator (PneuNet)" in text
@@ -81,6 +85,7 @@ def test_report_section_has_the_books_numbers_and_the_claims(ch2):
                           flags=re.MULTILINE)) == len(CLAIMS)  # fmt: skip
 
 
+@pytest.mark.slow
 def test_figures_are_written_and_linked(ch2):
     out = ch2[0]
     for name in FIGURES:
@@ -89,6 +94,7 @@ def test_figures_are_written_and_linked(ch2):
     assert sorted(Path(link).stem for link in links) == sorted(FIGURES)
 
 
+@pytest.mark.slow
 def test_the_sweep_file_beside_the_report_has_nothing_left_to_run(ch2):
     out = ch2[0] / "ch2"
     sweep = out / "table2_3_sweep"

@@ -10,6 +10,7 @@ from articula.plants.six_chamber import SixChamberParams
 P = SixChamberParams()
 
 
+@pytest.mark.slow
 def test_defaults_reproduce_the_books_undamped_deactuation():
     m = undamped(P)
     assert 18.0 <= m["peak_true_deg"] <= 20.0

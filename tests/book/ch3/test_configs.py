@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import pytest
+
 from articula.book.study import packaged
 
 
+@pytest.mark.slow
 def test_delta_sweep_file_runs_through_articula_sweep(cli, tmp_path):
     proc = cli("sweep", packaged("ch3", "delta_quick.toml"), "--out", tmp_path / "sweep", "--json")
     assert proc.returncode == 0, proc.stderr

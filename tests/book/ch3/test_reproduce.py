@@ -9,6 +9,10 @@ import pytest
 
 from articula.book.ch3.book_values import CLAIM_BOOK, CLAIM_GROWS
 
+# The whole chapter takes about 20 s; chapter 4's run (tests/book/conftest.py) stands for
+# `articula reproduce` in the default step.
+pytestmark = pytest.mark.slow
+
 KEYS = {"delta", "peak_deg", "settling_s", "overshoot_pct", "open_ms", "claims", "search"}
 
 

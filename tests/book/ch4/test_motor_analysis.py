@@ -23,15 +23,19 @@ TRANSFER_KEYS = {"omega/tau_ex", "omega/V", "i/tau_ex", "i/V"}
 TRANSFER_ENTRY = {"omega/tau_ex": (0, 0), "omega/V": (0, 1), "i/tau_ex": (1, 0), "i/V": (1, 1)}
 
 
-@pytest.fixture
+@pytest.fixture(scope="module")
 def analyze(cli, one_json):
-    """analyze(*args) -> the JSON object of `articula motor analyze *args --json`."""
+    """analyze(*args) -> the JSON object of `articula motor analyze *args --json`, each
+    command run once for the module (a fresh object for every caller)."""
+    done: dict[tuple[str, ...], str] = {}
 
     def run(*args: str) -> dict:
-        proc = cli("motor", "analyze", *args, "--json")
-        assert proc.returncode == 0, proc.stderr
-        assert proc.stderr == ""
-        return one_json(proc.stdout)
+        if args not in done:
+            proc = cli("motor", "analyze", *args, "--json")
+            assert proc.returncode == 0, proc.stderr
+            assert proc.stderr == ""
+            done[args] = proc.stdout
+        return one_json(done[args])
 
     return run
 
@@ -173,6 +177,7 @@ PARAM_FILES = {
 }
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(
     "case",
     [
@@ -203,6 +208,7 @@ BAD_ARGS = {
 }
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize(
     "args",
     [["--preset", "table4.2", "--current", "2"], ["--preset", "table4.1", "--voltage", "0"]],
@@ -224,6 +230,7 @@ def _fill(args: list[str], tmp_path: Path) -> list[str]:
     return [a.format(tmp=tmp_path, good=good) for a in args]
 
 
+@pytest.mark.slow_cases(keep=1)
 @pytest.mark.parametrize("case", sorted(BAD_ARGS))
 def test_motor_analyze_bad_arguments(cli, tmp_path, assert_one_line_error, case):
     args, names = BAD_ARGS[case]
