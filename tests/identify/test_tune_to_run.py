@@ -10,6 +10,7 @@ import tomllib
 import pytest
 
 
+@pytest.mark.slow
 def test_the_tuned_config_runs_on_the_rig_and_on_the_model_without_an_edit(
     emulate_process, cli, tmp_path
 ):
@@ -35,6 +36,7 @@ def test_the_tuned_config_runs_on_the_rig_and_on_the_model_without_an_edit(
     assert both["metrics"]["cost_median"] == pytest.approx(result["cost"], rel=0.1)
 
 
+@pytest.mark.slow
 def test_rig_run_shows_the_rig_beside_its_model(emulate_process, cli, tmp_path):
     _, port = emulate_process("pneunet")
     tuned = cli("rig", "tune", port, "--method", "manual", "--levels", "45", "--out",
