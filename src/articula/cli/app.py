@@ -56,13 +56,6 @@ Workers = Annotated[
         help="Local worker processes (default: one per core).",
     ),
 ]
-RtPriority = Annotated[
-    int | None,
-    typer.Option(
-        help="Run under real-time scheduling (SCHED_FIFO) at this priority, 1-99, so that a "
-        "busy host cannot starve the line or the stream (needs root or CAP_SYS_NICE).",
-    ),
-]
 Force = Annotated[
     bool,
     typer.Option(
@@ -83,10 +76,6 @@ def _print_version(wanted: bool) -> None:
         raise typer.Exit()
 
 
-# Commands whose first run compiles the numba kernels (about a minute on a fresh install).
-COMPILING = frozenset({"plan", "run", "sweep", "live", "view", "drive", "reproduce", "bench"})
-
-
 @app.callback()
 def _root(
     ctx: typer.Context,
@@ -98,11 +87,10 @@ def _root(
     ] = False,
 ) -> None:
     """The options of `articula` itself."""
-    if ctx.invoked_subcommand in COMPILING and err.is_terminal:  # a person waits, not a log
-        from articula.numba_cache import is_cold
+    if err.is_terminal:  # a person waits, not a log
+        from articula.cli.first_run import notice
 
-        if is_cold():
-            err.print("compiling articula's kernels once (about a minute); later runs load them")
+        notice(ctx.invoked_subcommand, err)
 
 
 def emit_json(obj: Any) -> None:
@@ -157,15 +145,3 @@ def progress_bar(quiet: bool) -> Progress:
         disable=quiet or not err.is_terminal,
         transient=True,
     )
-
-
-def use_realtime(priority: int | None) -> None:
-    """Real-time scheduling for this process from now on (arms.realtime), if asked for.
-
-    Args:
-        priority: the SCHED_FIFO priority (1-99); None: ordinary scheduling.
-    """
-    if priority is not None:
-        from articula.arms.realtime import use_realtime as switch
-
-        switch(priority)

@@ -8,7 +8,8 @@ from typing import Annotated
 
 import typer
 
-from articula.cli.app import Force, OutDir, RtPriority, app, out
+from articula.cli.app import Force, OutDir, app, out
+from articula.cli.realtime import RtPriority
 
 
 @app.command()

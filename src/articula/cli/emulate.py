@@ -8,7 +8,8 @@ from typing import Annotated
 
 import typer
 
-from articula.cli.app import RtPriority, app, out, use_realtime
+from articula.cli.app import app, out
+from articula.cli.realtime import RtPriority, use_realtime
 
 
 @app.command()

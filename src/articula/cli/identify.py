@@ -11,13 +11,12 @@ from articula.cli.app import (
     Force,
     JsonFlag,
     OutDir,
-    RtPriority,
     app,
     emit_json,
     out,
     progress_bar,
-    use_realtime,
 )
+from articula.cli.realtime import RtPriority, use_realtime
 from articula.cli.rigs import Port, rig_app
 
 Window = Annotated[

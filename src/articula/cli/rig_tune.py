@@ -12,12 +12,11 @@ from articula.cli.app import (
     Force,
     JsonFlag,
     OutDir,
-    RtPriority,
     emit_json,
     out,
     progress_bar,
-    use_realtime,
 )
+from articula.cli.realtime import RtPriority, use_realtime
 from articula.cli.rigs import Port, rig_app
 
 

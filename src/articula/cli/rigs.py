@@ -11,14 +11,13 @@ from articula.cli.app import (
     Force,
     JsonFlag,
     OutDir,
-    RtPriority,
     app,
     emit_json,
     metric_rows,
     out,
     print_table,
-    use_realtime,
 )
+from articula.cli.realtime import RtPriority, use_realtime
 
 rig_app = typer.Typer(no_args_is_help=True, help="A bench rig on a serial port.")
 app.add_typer(rig_app, name="rig")
