@@ -1,6 +1,6 @@
 """The rigs' serial link over a pseudo-terminal (issue "Bench rigs over serial").
 
-    python benchmarks/rig_link.py [--json] [--commands N] [--seconds S]
+    python benchmarks/rig_link.py [--json] [--commands N] [--seconds S] [--busy-runs R]
 
 `articula emulate pneunet --fast` runs in its own process, as a device would; this process
 opens its pty with pyserial through articula.rigs.link.Link, as `articula rig` does:
@@ -12,6 +12,9 @@ opens its pty with pyserial through articula.rigs.link.Link, as `articula rig` d
                            host keeps up with (target >= 2)
   raw_roundtrip_ms_p50     the baseline: one byte written to a pty and read back by an echo
                            process in the same setup, no protocol (what the line itself costs)
+  busy_host_timeout_stops  with --busy-runs R: of R motor runs with a CPU hog on every core,
+                           those the device stopped for a silent host (benchmarks/rig_busy.py,
+                           the firmware in simavr where it is built; busy_* its other keys)
 """
 
 from __future__ import annotations
@@ -40,7 +43,7 @@ ARTICULA = Path(sys.executable).parent / "articula"
 ECHO = "import os, sys\nwhile True:\n    os.write(1, os.read(0, 1))\n"
 
 
-def measure(commands: int, seconds: float) -> dict[str, Any]:
+def measure(commands: int, seconds: float, busy_runs: int = 0) -> dict[str, Any]:
     """The keys of the module's docstring."""
     device = subprocess.Popen([ARTICULA, "emulate", "pneunet", "--fast"], stdout=subprocess.PIPE,
                               stderr=subprocess.PIPE, text=True)  # fmt: skip
@@ -73,6 +76,12 @@ def measure(commands: int, seconds: float) -> dict[str, Any]:
         device.wait(10)
     m["motor_loop_ratio"] = m["telemetry_hz"] / 1000.0
     m["raw_roundtrip_ms_p50"] = 1e3 * _raw_roundtrip(commands)
+    if busy_runs:
+        import rig_busy
+
+        firmware = rig_busy.FIRMWARE.is_file()
+        busy = rig_busy.measure(busy_runs, 2.0, 1, firmware, 0)
+        m |= {f"busy_{key}": value for key, value in busy.items()}
     return m
 
 
@@ -106,10 +115,15 @@ def table(m: dict[str, Any]) -> tuple[str, list[str], list[list[str]]]:
         ["frames received / sent", f"{m['telemetry_frames']} / {m['telemetry_expected']}", ""],
         ["lost / damaged", f"{m['dropped_frames']} / {m['crc_errors']}", "0 / 0"],
     ]
+    if "busy_runs" in m:
+        stops = f"{m['busy_host_timeout_stops']} of {m['busy_runs']}"
+        rows.append(["runs stopped by the host timeout, every core busy", stops, "0"])
     return "rig link over a pseudo-terminal", ["measure", "value", "target"], rows
 
 
 if __name__ == "__main__":
     run(__doc__, measure, table,
         commands={"type": int, "default": 1000, "help": "commands timed"},
-        seconds={"type": float, "default": 600.0, "help": "seconds of telemetry"})  # fmt: skip
+        seconds={"type": float, "default": 600.0, "help": "seconds of telemetry"},
+        busy_runs={"type": int, "default": 0,
+                   "help": "motor runs with a CPU hog on every core (0: none)"})  # fmt: skip
