@@ -32,6 +32,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+import tomli_w
 from common import run
 
 from articula.arms.realtime import use_ordinary, use_realtime
@@ -64,7 +65,7 @@ def measure(
             config = Path(tmp) / "motor.toml"
             data = load_toml(packaged("ch4", "fig4_5.toml"))
             data |= {"duration": seconds, "settle": seconds / 2}
-            config.write_text(_toml(data))
+            config.write_text(tomli_w.dumps(data))
             for k in range(runs * len(lanes)):
                 lane = lanes[k % len(lanes)]
                 outcomes[lane].append(_one_run(port, config, Path(tmp) / f"run{k}", lane))
@@ -96,12 +97,6 @@ def _one_run(port: str, config: Path, out: Path, priority: int) -> tuple[str, fl
     finally:
         use_ordinary()
     return kind, time.perf_counter() - start
-
-
-def _toml(data: dict[str, Any]) -> str:
-    import tomli_w
-
-    return tomli_w.dumps(data)
 
 
 def table(m: dict[str, Any]) -> tuple[str, list[str], list[list[str]]]:

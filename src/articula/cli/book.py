@@ -7,6 +7,7 @@ from typing import Annotated, Any
 
 import typer
 
+from articula.book.claims import VERDICTS
 from articula.cli.app import (
     CORES,
     Dask,
@@ -59,8 +60,6 @@ def reproduce(
     if as_json:
         emit_json(summary)
         return
-    from articula.book.claims import VERDICTS
-
     chapters = summary["chapters"].items()
     rows = [(name, *verdict_counts(data["claims_detail"])) for name, data in chapters]
     print_table("the book's claims", ("chapter", *VERDICTS), rows)
@@ -76,8 +75,6 @@ def verdict_counts(details: list[dict[str, Any]]) -> tuple[str, ...]:
     Returns:
         The counts as table cells (reproduced, not reproduced, inconclusive).
     """
-    from articula.book.claims import VERDICTS
-
     return tuple(str(sum(d["verdict"] == v for d in details)) for v in VERDICTS)
 
 
